@@ -1,0 +1,20 @@
+# suspsim study workflow: the table of contents. Each stage lives in workflow/rules/.
+from snakemake.utils import min_version
+
+min_version("8.0")
+
+
+configfile: "config/config.yaml"
+
+
+report: "workflow/report/workflow.rst"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/fit.smk"
+
+
+rule all:
+    input:
+        all_outputs(),
+    default_target: True
