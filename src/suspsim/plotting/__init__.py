@@ -1,0 +1,1 @@
+"""Figures of suspsim results (object-oriented Matplotlib, no pyplot state, no file I/O)."""
