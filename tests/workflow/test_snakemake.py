@@ -57,7 +57,7 @@ def test_invalid_config_is_rejected(tmp_path):
     (study / "config/config.yaml").write_text("fit: {law: bingham}\n")
     proc = _run(study, "-n")
     assert proc.returncode != 0
-    assert "bingham" in proc.stderr
+    assert "bingham" in proc.stdout + proc.stderr
 
 
 def test_bad_matrix_file_fails_the_job_with_a_clear_log(tmp_path):

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import logging
 import os
-from pathlib import Path
 from typing import Sequence
 
 from ..errors import InputError
@@ -42,7 +41,7 @@ def fit_matrix_file(path: str | os.PathLike, *, law: str = "auto", sample: str |
             raise InputError(path, f"the file holds {len(samples)} samples "
                              f"({', '.join(samples)}); choose one with --sample")
     data = read_flow_curve(path, sample=sample)
-    source = f"{Path(path).name}" + (f" [sample {data['sample'].iloc[0]}]" if sample else "")
+    source = str(path) + (f" [sample {data['sample'].iloc[0]}]" if sample else "")
     try:
         result = fit_flow_curve(data["shear_rate"].to_numpy(), data["shear_stress"].to_numpy(),
                                 law=law, candidates=tuple(candidates), criterion=criterion,
