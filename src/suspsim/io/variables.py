@@ -1,0 +1,121 @@
+"""The output registry: every variable and attribute a run file may hold (CF-1.10 metadata).
+
+Unit convention. A run is computed in simulation units — length h (the kernel's support
+radius), mass m (the particle mass, m = 1) and time τ (the scene's time unit) — so its numbers
+are pure numbers: multiples of h, m and τ. In UDUNITS, "h" is the hour and "m" the metre, so
+these names must not appear in ``units``. Every variable therefore carries ``units = "1"``
+(CF: dimensionless), and, when it has a dimension, the attribute ``simulation_units`` states
+it in h, m and tau with UDUNITS exponent syntax, e.g. ``"m h-1 tau-2"`` for a 3-D stress. The
+global attribute ``unit_system`` (:data:`UNIT_SYSTEM`) says the same once per file. Stresses,
+viscosities and densities depend on the space dimension d (a 2-D stress is a force per
+length); :meth:`Variable.attrs` resolves that. A later conversion to SI replaces ``units`` and
+drops ``simulation_units``. No CF standard name fits dimensionless simulation quantities, so no
+variable has ``standard_name``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Mapping
+
+UNIT_SYSTEM = ("simulation units: length h = kernel support radius, mass m = particle mass, "
+               "time tau = scene time unit; variables have units '1' and state their dimension "
+               "in the attribute simulation_units")
+
+# Powers of (h, m, tau, V) with V = h^d the d-dimensional volume.
+_TIME = (0, 0, 1, 0)
+_LENGTH = (1, 0, 0, 0)
+_VELOCITY = (1, 0, -1, 0)
+_RATE = (0, 0, -1, 0)
+_STRESS = (2, 1, -2, -1)
+_VISCOSITY = (2, 1, -1, -1)
+_DENSITY = (0, 1, 0, -1)
+_ENERGY = (2, 1, -2, 0)
+_NONE = (0, 0, 0, 0)
+
+
+def simulation_units(powers: tuple[int, int, int, int], dimension: int) -> str:
+    """UDUNITS-style unit string in h, m, tau for ``powers`` of (h, m, tau, h^d); "1" if none."""
+    length, mass, time, volume = powers
+    terms = zip(("m", "h", "tau"), (mass, length + dimension * volume, time))
+    text = " ".join(name if p == 1 else f"{name}{p}" for name, p in terms if p != 0)
+    return text or "1"
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One output variable: name, dimensions, long_name and powers of (h, m, tau, h^d).
+
+    A variable whose only dimension is its own name is a coordinate (``time``, ``y``).
+    """
+
+    name: str
+    dims: tuple[str, ...]
+    long_name: str
+    powers: tuple[int, int, int, int] = _NONE
+    standard_name: str | None = None
+    comment: str | None = None
+
+    @property
+    def is_coordinate(self) -> bool:
+        return self.dims == (self.name,)
+
+    def attrs(self, dimension: int) -> dict[str, str]:
+        """netCDF attributes of this variable in a ``dimension``-D run."""
+        out = {"units": "1", "long_name": self.long_name}
+        if self.powers != _NONE:
+            out["simulation_units"] = simulation_units(self.powers, dimension)
+        if self.standard_name:
+            out["standard_name"] = self.standard_name
+        if self.comment:
+            out["comment"] = self.comment
+        return out
+
+
+_T, _Y = ("time",), ("y",)
+
+VARIABLES: Mapping[str, Variable] = MappingProxyType({v.name: v for v in (
+    Variable("time", _T, "simulated time", _TIME),
+    Variable("y", _Y, "bin centre along the gradient direction y", _LENGTH),
+    Variable("strain", _T, "accumulated shear strain (shear rate times time)"),
+    Variable("shear_stress", _T, "shear stress sigma_xy of the whole box", _STRESS,
+             comment="virial stress relative to the imposed flow (SPEC 2.8)"),
+    Variable("pressure", _T, "mean pressure -trace(sigma)/d of the whole box", _STRESS),
+    Variable("kinetic_energy", _T, "kinetic energy per particle, m <|v|^2>/2", _ENERGY),
+    Variable("density_error", _T, "largest relative density deviation max |rho - rho_eq|/rho_eq"),
+    Variable("mach", _T, "Mach number max |v|/c"),
+    Variable("viscosity", (), "shear viscosity sigma_xy/shear_rate averaged after the transient",
+             _VISCOSITY),
+    Variable("viscosity_stderr", (), "standard error of viscosity (block averaging)", _VISCOSITY),
+    Variable("velocity_profile", _Y, "time-averaged flow velocity v_x per bin of y", _VELOCITY),
+    Variable("viscosity_profile", _Y, "time-averaged particle viscosity per bin of y", _VISCOSITY),
+    Variable("shear_rate_profile", _Y, "time-averaged local shear rate per bin of y", _RATE),
+    Variable("density_profile", _Y, "time-averaged mass density per bin of y", _DENSITY),
+    Variable("reference_velocity_profile", _Y, "analytic flow velocity v_x per bin of y", _VELOCITY,
+             comment="continuum solution for the scene's law and flow (SPEC 6)"),
+)})
+
+
+@dataclass(frozen=True)
+class Attribute:
+    """A global attribute a run sets: type (int or float) and description with units."""
+
+    name: str
+    type: type
+    description: str
+
+
+RUN_ATTRIBUTES: Mapping[str, Attribute] = MappingProxyType({a.name: a for a in (
+    Attribute("n_particles", int, "number of SPH particles"),
+    Attribute("n_steps", int, "time steps taken, over all resumed segments"),
+    Attribute("wall_time_s", float, "wall-clock duration over all resumed segments [s]"),
+    Attribute("particle_steps_per_s", float, "particles times steps per wall-clock second [1/s]"),
+    Attribute("reynolds_number", float, "Reynolds number rho v L / mu of the flow [1]"),
+    Attribute("mach_number", float, "largest Mach number max |v|/c during the run [1]"),
+    Attribute("completed", int, "1 if the run reached its end, 0 if it stopped early"),
+    Attribute("dt", float, "time step used [tau]"),
+    Attribute("sound_speed", float, "sound speed c used [h/tau]"),
+)})
+
+#: Run attributes every output must set.
+REQUIRED_RUN_ATTRIBUTES = ("wall_time_s", "completed")

@@ -1,0 +1,228 @@
+"""Scenes: the validated, complete description of one SPH run (SPEC §2), without I/O beyond loading.
+
+A scene file is YAML. Its structure, types, descriptions and defaults live in the JSON schema
+``suspsim/schemas/scene.schema.json`` (Draft 2020-12); the cross-key rules and the resolution
+of ``auto`` values live in :mod:`suspsim.scene_rules`. Every
+problem becomes one :class:`~suspsim.errors.InputError` line naming the file, the line and the
+key, e.g. ``scene.yaml:9 [key 'flow.shear_rate']: couette flow needs shear_rate > 0``.
+
+Simulation units: length h (the kernel's support radius, for lucy and quintic alike), mass m
+(the particle mass, m = 1) and time τ (the unit of the law parameters and rates in the scene).
+A density is then number_density × m [m h^-d], a viscosity m h^(2−d) τ^-1, a shear rate τ^-1.
+``run.output_interval`` and ``run.transient`` count in the unit of the run length: strain when
+``run.strain`` is given, τ when ``run.time`` is.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields
+from functools import partial
+from os import PathLike
+from typing import Any, Mapping, NoReturn
+
+import numpy as np
+
+from .errors import InputError
+from .io.schema import dotted_key, fill_defaults, load_schema, validate
+from .io.yamlfile import load_yaml
+from .rheology.laws import ConstitutiveLaw
+from .scene_rules import lattice_counts, resolve
+
+#: The scene schema (a dict), with a description and default for every optional key.
+SCENE_SCHEMA = load_schema("scene")
+#: Particle mass m [m]: the mass unit.
+PARTICLE_MASS = 1.0
+
+
+@dataclass(frozen=True)
+class FluidSpec:
+    """The matrix fluid: ``law`` with parameters in simulation units."""
+
+    law: ConstitutiveLaw
+
+
+@dataclass(frozen=True)
+class FlowSpec:
+    """Imposed flow: ``type`` couette or poiseuille; ``shear_rate`` [τ^-1]; ``body_force`` g [h τ^-2]."""
+
+    type: str
+    shear_rate: float
+    body_force: float
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Run settings with every default resolved except the solver's ``dt`` and ``sound_speed``.
+
+    ``strain`` [1] or ``time`` [τ] (the other is None); ``dt`` [τ] and ``sound_speed`` [h/τ]
+    are None for auto; ``output_interval`` and ``transient`` in the unit of the run length;
+    ``checkpoint_interval_s`` [s wall clock]; ``threads`` None for all cores.
+    """
+
+    strain: float | None
+    time: float | None
+    dt: float | None
+    sound_speed: float | None
+    start: str
+    output_interval: float
+    checkpoint_interval_s: float
+    transient: float
+    profile_bins: int
+    threads: int | None
+    max_density_error: float
+    max_mach: float
+
+    @property
+    def length(self) -> float:
+        """The run length in its own unit (strain or τ)."""
+        return self.strain if self.strain is not None else self.time
+
+    def to_dict(self) -> dict:
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        for name in ("strain", "time"):
+            if out[name] is None:
+                del out[name]
+        out["dt"] = "auto" if self.dt is None else self.dt
+        out["sound_speed"] = "auto" if self.sound_speed is None else self.sound_speed
+        out["threads"] = "all" if self.threads is None else self.threads
+        return out
+
+
+@dataclass(frozen=True)
+class LatticeSpec:
+    """Initial lattice: ``jitter`` [lattice spacings], uniform in ±jitter per coordinate."""
+
+    jitter: float
+
+
+@dataclass(frozen=True)
+class NumericsSpec:
+    """Scheme choices (SPEC §2.3–2.6); add a field here and a key in the schema together."""
+
+    bulk_correction: bool
+    viscous_normalisation: bool
+    wi_target: float
+    dt_viscous_coefficient: float
+
+
+@dataclass(frozen=True)
+class InclusionsSpec:
+    """Rigid inclusions (reserved): ``volume_fraction`` φ [1]."""
+
+    volume_fraction: float
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A complete, validated scene; ``box`` [h] is (x flow, y gradient[, z]), ``number_density`` [h^-d]."""
+
+    dimension: int
+    box: tuple[float, ...]
+    number_density: float
+    kernel: str
+    fluid: FluidSpec
+    flow: FlowSpec
+    run: RunSpec
+    lattice: LatticeSpec
+    numerics: NumericsSpec
+    inclusions: InclusionsSpec
+    seed: int
+    source: str = field(default="<dict>", compare=False, repr=False)
+
+    @property
+    def mass(self) -> float:
+        """Particle mass m [m]."""
+        return PARTICLE_MASS
+
+    @property
+    def density(self) -> float:
+        """Nominal mass density ρ = number_density × m [m h^-d]."""
+        return self.number_density * PARTICLE_MASS
+
+    @property
+    def volume(self) -> float:
+        """Box volume (area in 2-D) [h^d]."""
+        return math.prod(self.box)
+
+    @property
+    def lattice_spacing(self) -> float:
+        """Nominal lattice spacing number_density^(−1/d) [h]."""
+        return self.number_density ** (-1.0 / self.dimension)
+
+    @property
+    def lattice_counts(self) -> tuple[int, ...]:
+        """Lattice sites per box side: round(side / spacing); their product is the particle count."""
+        return lattice_counts(self.box, self.number_density)
+
+    @property
+    def total_time(self) -> float:
+        """Simulated time of the whole run [τ]."""
+        return self.to_time(self.run.length)
+
+    @property
+    def output_interval_time(self) -> float:
+        """Time between samples [τ]."""
+        return self.to_time(self.run.output_interval)
+
+    @property
+    def transient_time(self) -> float:
+        """Time discarded before averaging [τ]."""
+        return self.to_time(self.run.transient)
+
+    def to_time(self, value: float) -> float:
+        """Convert a value in the run-length unit (strain or τ) to time [τ]."""
+        return value if self.run.time is not None else value / self.flow.shear_rate
+
+    def to_dict(self) -> dict:
+        """The complete scene, defaults included, as plain JSON-able data."""
+        return {"dimension": self.dimension, "box": list(self.box),
+                "number_density": self.number_density, "kernel": self.kernel,
+                "fluid": {"law": self.fluid.law.name, "params": dict(self.fluid.law.params)},
+                "flow": asdict(self.flow), "run": self.run.to_dict(),
+                "lattice": asdict(self.lattice), "numerics": asdict(self.numerics),
+                "inclusions": asdict(self.inclusions), "seed": self.seed}
+
+
+def load_scene(path: str | PathLike) -> Scene:
+    """Read and validate a scene file; raises :class:`InputError` with file, line and key."""
+    data, lines = load_yaml(path)
+    return _build(data, str(path), lines)
+
+
+def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
+    """Validate a scene given as a mapping (tuples and NumPy scalars are accepted)."""
+    return _build(_plain(data), source, {})
+
+
+def _plain(data):
+    if isinstance(data, Mapping):
+        return {k: _plain(v) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [_plain(v) for v in data]
+    return data.item() if isinstance(data, np.generic) else data
+
+
+def _fail(source: str, lines: Mapping[tuple, int], path: tuple, problem: str) -> NoReturn:
+    line = next((lines[path[:i]] for i in range(len(path), 0, -1) if path[:i] in lines), None)
+    raise InputError(source, problem, line=line, key=dotted_key(path) or None)
+
+
+def _build(data, source: str, lines: Mapping[tuple, int]) -> Scene:
+    if data is None:
+        raise InputError(source, "the scene is empty; it must be a mapping of keys to values")
+    if not isinstance(data, dict):
+        raise InputError(source, "a scene must be a mapping of keys to values, "
+                         f"not a {type(data).__name__}")
+    validate(data, SCENE_SCHEMA, source=source, lines=lines)
+    full, law = resolve(fill_defaults(data, SCENE_SCHEMA), data["run"], partial(_fail, source, lines))
+    run = {f.name: full["run"].get(f.name) for f in fields(RunSpec)}
+    run.update({key: None for key in ("dt", "sound_speed", "threads") if run[key] in ("auto", "all")})
+    numerics = {f.name: float(full["numerics"][f.name]) if f.type == "float" else full["numerics"][f.name]
+                for f in fields(NumericsSpec)}
+    return Scene(dimension=full["dimension"], box=tuple(float(s) for s in full["box"]),
+                 number_density=float(full["number_density"]), kernel=full["kernel"],
+                 fluid=FluidSpec(law), flow=FlowSpec(**full["flow"]), run=RunSpec(**run),
+                 lattice=LatticeSpec(float(full["lattice"]["jitter"])),
+                 numerics=NumericsSpec(**numerics),
+                 inclusions=InclusionsSpec(float(full["inclusions"]["volume_fraction"])),
+                 seed=int(full["seed"]), source=source)

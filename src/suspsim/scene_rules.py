@@ -1,0 +1,133 @@
+"""Cross-key rules of a scene and the resolution of its ``auto`` defaults, on plain data.
+
+:func:`resolve` takes a scene that passed the schema (defaults filled) and returns it complete:
+run length rules checked, ``run.start``, ``run.output_interval``, ``run.transient`` and
+``run.profile_bins`` resolved, numbers as floats. ``run.dt``, ``run.sound_speed`` ("auto") and
+``run.threads`` ("all") stay for the solver. Problems go to ``fail(key_path, problem)``, which
+raises. Units as in :mod:`suspsim.scene`.
+"""
+from __future__ import annotations
+
+import math
+import re
+from typing import Callable, NoReturn
+
+from .rheology.laws import LAW_SPECS, ConstitutiveLaw, make_law
+
+Fail = Callable[[tuple, str], NoReturn]
+
+#: Smallest box side [h]: three kernel supports, so no particle meets its own periodic image.
+MIN_BOX_SIDE = 3.0
+#: Largest relative gap between the initial lattice's density and number_density [choice].
+LATTICE_DENSITY_TOLERANCE = 0.01
+#: Automatic sampling of couette runs: every 0.05 strain, at least 20 samples [choice].
+AUTO_OUTPUT_STRAIN = 0.05
+AUTO_OUTPUT_MIN_SAMPLES = 20
+#: Automatic sampling of poiseuille runs: 200 samples over the run [choice].
+AUTO_OUTPUT_SAMPLES_POISEUILLE = 200
+
+
+def resolve(scene: dict, given_run: dict, fail: Fail) -> tuple[dict, ConstitutiveLaw]:
+    """Check the cross-key rules and return ``(complete scene, law)``.
+
+    ``scene`` has passed the schema with defaults filled; ``given_run`` is the ``run`` mapping
+    as the user wrote it (to tell an explicit ``start`` from the default).
+    """
+    out = {**scene, "dimension": int(scene["dimension"])}
+    _check_box(out["dimension"], scene["box"], fail)
+    law = _make_law(scene["fluid"], fail)
+    out["fluid"] = {"law": law.name, "params": dict(law.params)}
+    out["flow"] = _check_flow(scene["flow"], fail)
+    out["run"] = _resolve_run(scene["run"], given_run, out["flow"], scene["box"], fail)
+    _check_lattice(out["dimension"], scene["box"], scene["number_density"], fail)
+    return out, law
+
+
+def lattice_counts(box, number_density: float) -> tuple[int, ...]:
+    """Sites per side of the simple cubic/square lattice at ``number_density`` [h^-d] in ``box`` [h]."""
+    spacing = number_density ** (-1.0 / len(box))
+    return tuple(max(1, round(side / spacing)) for side in box)
+
+
+def _check_box(dim: int, box, fail: Fail) -> None:
+    if len(box) != dim:
+        fail(("box",), f"a {dim}-D scene needs {dim} box lengths "
+                       f"({'x, y, z' if dim == 3 else 'x, y'}), got {len(box)}")
+    for i, side in enumerate(box):
+        if side < MIN_BOX_SIDE:
+            fail(("box", i), f"box side {side:g} h holds fewer than {MIN_BOX_SIDE:g} kernel "
+                             f"supports; make it at least {MIN_BOX_SIDE:g}")
+
+
+def _make_law(fluid: dict, fail: Fail) -> ConstitutiveLaw:
+    name, params = fluid["law"], fluid["params"]
+    if name not in LAW_SPECS:
+        fail(("fluid", "law"), f"unknown law {name!r}; known laws: {', '.join(LAW_SPECS)}")
+    try:
+        return make_law(name, params)
+    except ValueError as err:
+        named = re.match(r"\w+: (?:parameter )?(\w+)\b", str(err))
+        which = (named.group(1),) if named and named.group(1) in params else ()
+        fail(("fluid", "params", *which), str(err))
+
+
+def _check_flow(flow: dict, fail: Fail) -> dict:
+    kind, rate, force = flow["type"], float(flow["shear_rate"]), float(flow["body_force"])
+    if kind == "couette":
+        if rate <= 0:
+            fail(("flow", "shear_rate"), "couette flow needs shear_rate > 0 [1/tau]")
+        if force != 0:
+            fail(("flow", "body_force"), "couette flow takes no body force; remove it or set 0")
+    else:
+        if force <= 0:
+            fail(("flow", "body_force"), "poiseuille flow needs body_force > 0 [h/tau^2]")
+        if rate != 0:
+            fail(("flow", "shear_rate"), "poiseuille flow has no imposed shear rate; remove it or set 0")
+    return {"type": kind, "shear_rate": rate, "body_force": force}
+
+
+def _resolve_run(run: dict, given: dict, flow: dict, box, fail: Fail) -> dict:
+    if "strain" in run and "time" in run:
+        fail(("run", "time"), "give either run.strain or run.time, not both")
+    if "strain" not in run and "time" not in run:
+        fail(("run", "strain"), "missing the run length: give run.strain (couette) or run.time")
+    couette = flow["type"] == "couette"
+    if not couette and "strain" in run:
+        fail(("run", "strain"), "poiseuille flow has no imposed strain; give run.time instead")
+    if not couette and given.get("start", "rest") != "rest":
+        fail(("run", "start"), "poiseuille flow starts from rest; remove run.start or set it to rest")
+    length_key = "strain" if "strain" in run else "time"
+    length = float(run[length_key])
+    interval = run["output_interval"]
+    if interval == "auto" and couette:
+        per_strain = 1.0 if length_key == "strain" else 1.0 / flow["shear_rate"]
+        interval = min(AUTO_OUTPUT_STRAIN * per_strain, length / AUTO_OUTPUT_MIN_SAMPLES)
+    elif interval == "auto":
+        interval = length / AUTO_OUTPUT_SAMPLES_POISEUILLE
+    elif interval > length:
+        fail(("run", "output_interval"), f"output_interval {interval:g} exceeds the run "
+                                         f"{length_key} {length:g}")
+    transient = length / 2 if run["transient"] == "auto" else run["transient"]
+    if transient >= length:
+        fail(("run", "transient"), f"transient {transient:g} leaves nothing of the run "
+                                   f"{length_key} {length:g} to average")
+    out = {key: (float(v) if isinstance(v, (int, float)) else v) for key, v in run.items()}
+    out.update({length_key: length, "start": run["start"] if couette else "rest",
+                "output_interval": float(interval), "transient": float(transient),
+                "profile_bins": (max(1, int(box[1])) if run["profile_bins"] == "auto"
+                                 else int(run["profile_bins"]))})
+    if run["threads"] != "all":
+        out["threads"] = int(run["threads"])
+    return out
+
+
+def _check_lattice(dim: int, box, n: float, fail: Fail) -> None:
+    counts = lattice_counts(box, n)
+    actual = math.prod(counts) / math.prod(box)
+    if abs(actual / n - 1) > LATTICE_DENSITY_TOLERANCE:
+        spacing = n ** (-1.0 / dim)
+        fitting = ", ".join(f"{c * spacing:.4g}" for c in counts)
+        fail(("number_density",),
+             f"a {'x'.join(map(str, counts))} lattice gives {actual:.4g} particles per h^{dim} "
+             f"in this box, {100 * (actual / n - 1):+.1f} % off number_density {n:g}; use box "
+             f"sides that are multiples of the spacing {spacing:.4g} h, e.g. [{fitting}]")
