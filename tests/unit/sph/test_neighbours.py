@@ -1,0 +1,327 @@
+"""Cell sort, neighbour list, rebuild criterion and summation density against brute force."""
+import itertools
+import math
+
+import numba
+import numpy as np
+import pytest
+
+from suspsim.sph import kernels as K
+from suspsim.sph import neighbours as nb
+from suspsim.sph.density import (DX, DZ, F, N_IMAGE, allocate_pair_table, summation_density,
+                                 summation_density_serial)
+
+CUTOFF = 1.0
+BOXES = {3: [(3.3, 4.2, 3.0), (4.5, 3.1, 4.0)], 2: [(3.3, 4.2, 1.0), (4.5, 3.1, 1.0)]}
+
+
+def image_shifts(box, offset, dim):
+    zs = (-1, 0, 1) if dim == 3 else (0,)
+    return np.array([(mx * box[0] + n * offset, n * box[1], mz * box[2])
+                     for n, mx, mz in itertools.product((-1, 0, 1), (-2, -1, 0, 1, 2), zs)])
+
+
+def brute_force_distances(positions, box, offset, dim):
+    """(N, N) distance to the nearest image, by enumerating images."""
+    d = positions[:, None, :] - positions[None, :, :]
+    best = np.full(d.shape[:2], np.inf)
+    for s in image_shifts(box, offset, dim):
+        best = np.minimum(best, np.sqrt(((d - s) ** 2).sum(-1)))
+    return best
+
+
+def brute_force_pairs(positions, box, offset, cutoff, dim):
+    r = brute_force_distances(positions, box, offset, dim)
+    i, j = np.nonzero(np.triu(r < cutoff, 1))
+    return set(zip(i.tolist(), j.tolist()))
+
+
+def listed_arrays(nlist):
+    """(i, j, k) of every listed pair, k its slot in ``neighbours``."""
+    counts = np.diff(nlist.start)
+    i = np.repeat(np.arange(len(counts)), counts)
+    k = np.arange(nlist.start[-1])
+    return i, nlist.neighbours[k].astype(np.int64), k
+
+
+def listed(nlist):
+    i, j, _ = listed_arrays(nlist)
+    return list(zip(i.tolist(), j.tolist()))
+
+
+def scene(kind, box, dim, rng, density=5.0):
+    box = np.array(box, dtype=float)
+    if kind == "random":
+        n = int(density * np.prod(box[:dim]))
+        positions = rng.uniform(0, 1, (n, 3)) * box
+    else:  # a lattice that does not fit the box, so rows meet the faces unevenly
+        axes = [np.arange(0.05, box[a], 0.53) for a in range(dim)] + [np.zeros(1)] * (3 - dim)
+        positions = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3)
+    if dim == 2:
+        positions[:, 2] = 0.0
+    return box, positions
+
+
+def build(positions, box, dim, offset, shear_rate=0.0, skin=0.0, half=True, support=CUTOFF):
+    nlist = nb.allocate_neighbour_list(len(positions), box, support, skin, dim,
+                                       len(positions) / np.prod(box[:dim]), half=half)
+    velocities = np.zeros_like(positions)
+    nb.rebuild_neighbour_list(nlist, positions, velocities, box, offset, shear_rate)
+    return nlist, velocities
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("kind", ["random", "lattice"])
+@pytest.mark.parametrize("box_index", [0, 1])
+@pytest.mark.parametrize("offset_fraction", [0.0, 0.37, 1.0, 1.5, 2.9])
+def test_list_equals_brute_force(dim, kind, box_index, offset_fraction):
+    rng = np.random.default_rng(11)
+    box, positions = scene(kind, BOXES[dim][box_index], dim, rng)
+    cell = box[0] / nb.cell_grid(box, CUTOFF, dim)[0]
+    offset = (offset_fraction * cell) % box[0]  # multiples and non-multiples of the cell size
+    for half in (True, False):
+        p = positions.copy()
+        nlist, _ = build(p, box, dim, offset, half=half)
+        pairs = listed(nlist)
+        assert len(pairs) == len(set(pairs)) == nlist.n_pairs
+        expected = brute_force_pairs(p, box, offset, CUTOFF, dim)
+        if half:
+            assert all(i < j for i, j in pairs)
+            assert set(pairs) == expected
+        else:
+            assert set(pairs) == expected | {(j, i) for i, j in expected}
+        # first part of each segment: pairs whose plain difference is the nearest image
+        i, j, k = listed_arrays(nlist)
+        plain = np.linalg.norm(p[i] - p[j], axis=1) < CUTOFF
+        np.testing.assert_array_equal(plain, k < nlist.image_start[i])
+
+
+def test_sort_and_permutation():
+    rng = np.random.default_rng(2)
+    box = np.array([4.0, 5.0, 3.0])
+    cells = nb.cell_grid(box, 1.0, 3)
+    positions = rng.uniform(0, 1, (300, 3)) * box
+    cell_of = np.zeros(300, dtype=np.int64)
+    order = np.zeros(300, dtype=np.int64)
+    cell_start = np.zeros(np.prod(cells) + 1, dtype=np.int64)
+    nb.sort_by_cell(positions, box, cells, cell_of, order, cell_start)
+    assert sorted(order) == list(range(300))
+    sorted_positions = np.empty_like(positions)
+    nb.apply_permutation(positions, order, sorted_positions)
+    np.testing.assert_array_equal(sorted_positions, positions[order])
+    ids = np.empty(300, dtype=np.int64)
+    nb.apply_permutation(np.arange(300), order, ids)
+    np.testing.assert_array_equal(ids, order)
+    c = np.floor(sorted_positions / (box / cells)).astype(int)
+    linear = (c[:, 0] * cells[1] + c[:, 1]) * cells[2] + c[:, 2]
+    assert np.all(np.diff(linear) >= 0)
+    np.testing.assert_array_equal(np.searchsorted(linear, np.arange(np.prod(cells) + 1)),
+                                  cell_start)
+
+
+def test_rebuild_permutes_particle_arrays_and_wraps():
+    rng = np.random.default_rng(4)
+    box = np.array([4.0, 5.0, 3.5])
+    positions = rng.uniform(-0.5, 1.1, (200, 3)) * box
+    velocities = rng.normal(size=(200, 3))
+    ids = np.arange(200)
+    nlist = nb.allocate_neighbour_list(200, box, 1.0, 0.1, 3, 200 / np.prod(box))
+    nb.rebuild_neighbour_list(nlist, positions, velocities, box, 0.5, 0.2, (ids,))
+    np.testing.assert_array_equal(ids, nlist.order)
+    assert np.all((positions >= 0) & (positions < box))
+    np.testing.assert_array_equal(nlist.reference, positions)
+
+
+SKIN = 0.3
+
+
+def moved_scene(rng):
+    box, positions = scene("random", (4.0, 5.3, 4.0), 3, rng, density=4.0)
+    offset = 1.1
+    nlist, _ = build(positions, box, 3, offset, skin=SKIN)
+    return box, positions, offset, nlist
+
+
+def missed_pairs(positions, box, offset, nlist):
+    within_h = brute_force_pairs(positions, box, offset, nlist.cutoff - nlist.skin, 3)
+    return within_h - set(listed(nlist))
+
+
+def test_no_pair_missed_below_half_skin():
+    rng = np.random.default_rng(5)
+    box, positions, offset, nlist = moved_scene(rng)
+    step = rng.normal(size=positions.shape)
+    step *= (0.499 * SKIN) * rng.uniform(0.5, 1, (len(step), 1)) / np.linalg.norm(step, axis=1)[:, None]
+    moved = positions + step  # unwrapped: positions may leave the box
+    assert not nb.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
+    assert not missed_pairs(moved, box, offset, nlist)
+
+
+def test_no_pair_missed_under_affine_shear():
+    # particles carried by v_x = γ̇ y for strain A while the image offset moves by A L_y: only
+    # the non-affine part counts, so no rebuild although particles moved up to A L_y = 2.1
+    rng = np.random.default_rng(6)
+    box, positions, offset, nlist = moved_scene(rng)
+    strain = 0.4
+    moved = positions.copy()
+    moved[:, 0] += strain * positions[:, 1]
+    moved += rng.uniform(-0.01, 0.01, moved.shape)
+    new_offset = (offset + strain * box[1]) % box[0]
+    assert not nb.needs_rebuild(moved, nlist.reference, strain, nlist.cutoff, SKIN)
+    assert not missed_pairs(moved, box, new_offset, nlist)
+
+
+def test_rebuild_triggered():
+    rng = np.random.default_rng(7)
+    box, positions, offset, nlist = moved_scene(rng)
+    reference = nlist.reference
+    moved = positions.copy()
+    moved[3, 0] += 0.16
+    assert not nb.needs_rebuild(moved, reference, 0.0, nlist.cutoff, SKIN)
+    moved[8, 1] -= 0.16  # two particles approaching by 0.32 > skin
+    assert nb.needs_rebuild(moved, reference, 0.0, nlist.cutoff, SKIN)
+    # at rest while the offset slides: the images of particles near the faces approach
+    assert not nb.needs_rebuild(positions, reference, 0.001, nlist.cutoff, SKIN)
+    assert nb.needs_rebuild(positions, reference, 0.1, nlist.cutoff, SKIN)
+    # affine motion: the strain alone triggers once the sheared cutoff sphere dips below h
+    sheared = positions.copy()
+    sheared[:, 0] += 0.6 * positions[:, 1]
+    assert nb.needs_rebuild(sheared, reference, 0.6, nlist.cutoff, SKIN)
+    wrapped = positions.copy()
+    wrapped[0, 1] -= box[1]  # a wrap between builds shows as a jump and forces a rebuild
+    assert nb.needs_rebuild(wrapped, reference, 0.0, nlist.cutoff, SKIN)
+    wrapped[0, 1] = np.nan
+    assert nb.needs_rebuild(wrapped, reference, 0.0, nlist.cutoff, SKIN)
+
+
+def test_a_pair_missed_when_the_criterion_fires():
+    # two particles 1.35 apart (outside r_c = 1.3) approach by 0.4: the list misses them
+    box = np.array([4.0, 4.0, 4.0])
+    positions = np.array([[1.0, 2.0, 2.0], [2.35, 2.0, 2.0]])
+    nlist, _ = build(positions.copy(), box, 3, 0.0, skin=SKIN)
+    moved = nlist.reference.copy()
+    moved[:, 0] += np.where(moved[:, 0] < 2, 0.2, -0.2)
+    assert missed_pairs(moved, box, 0.0, nlist)
+    assert nb.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
+
+
+def test_overflow_code_and_error():
+    rng = np.random.default_rng(8)
+    box, positions = scene("random", (4.0, 4.0, 4.0), 3, rng)
+    nlist = nb.allocate_neighbour_list(len(positions), box, 1.0, 0.2, 3, 1.0,
+                                       capacity_factor=0.05)
+    with pytest.raises(nb.NeighbourListOverflowError, match="capacity") as info:
+        nb.rebuild_neighbour_list(nlist, positions, np.zeros_like(positions), box, 0.0, 0.0)
+    code, required = nb.build_neighbour_list(positions, box, 0.0, nlist.cutoff, nlist.cells,
+                                             nlist.cell_start, nlist.start, nlist.image_start,
+                                             nlist.neighbours)
+    assert code == nb.PAIR_OVERFLOW and required == info.value.required
+    nlist.neighbours = np.zeros(required, dtype=np.int32)
+    code, n_pairs = nb.build_neighbour_list(positions, box, 0.0, nlist.cutoff, nlist.cells,
+                                            nlist.cell_start, nlist.start, nlist.image_start,
+                                            nlist.neighbours)
+    assert code == nb.OK and n_pairs <= required
+    assert set(listed(nlist)) == brute_force_pairs(positions, box, 0.0, nlist.cutoff, 3)
+
+
+def test_box_too_small():
+    with pytest.raises(ValueError, match="fewer than 3 cells"):
+        nb.cell_grid(np.array([3.0, 2.9, 3.0]), 1.0, 3)
+    assert list(nb.cell_grid(np.array([3.0, 3.5, 0.1]), 1.0, 2)) == [3, 3, 1]
+
+
+# ------------------------------------------------------------------------------ density
+
+def density_pass(positions, box, offset, nlist, kernel, h, n_chunks=2, table=None):
+    density = np.empty(len(positions))
+    table = table or allocate_pair_table(len(positions), len(nlist.neighbours))
+    scratch = np.empty((n_chunks - 1, len(positions)))
+    bounds = np.empty(n_chunks + 1, dtype=np.int64)
+    summation_density(positions, box, offset, nlist.start, nlist.image_start, nlist.neighbours,
+                      kernel, h, density, table.pair_end, table.pair_j, table.pair_geometry,
+                      scratch, bounds)
+    return density
+
+
+@pytest.mark.parametrize("dim,kernel", [(3, K.LUCY_3D), (2, K.LUCY_2D), (3, K.QUINTIC_3D),
+                                        (2, K.QUINTIC_2D)])
+@pytest.mark.parametrize("offset", [0.0, 1.37])
+def test_density_equals_brute_force(dim, kernel, offset):
+    rng = np.random.default_rng(9)
+    box, positions = scene("random", BOXES[dim][0], dim, rng)
+    h = 0.9
+    nlist, _ = build(positions, box, dim, offset, skin=0.1, support=h)
+    moved = positions + rng.uniform(-0.02, 0.02, positions.shape) * [1, 1, dim == 3]
+    r = brute_force_distances(moved, box, offset, dim)
+    expected = np.vectorize(lambda x: K.kernel_w(kernel, x, h))(r).sum(axis=1)
+    serial = np.empty(len(moved))
+    table = allocate_pair_table(len(moved), len(nlist.neighbours))
+    summation_density_serial(moved, box, offset, nlist.start, nlist.image_start,
+                             nlist.neighbours, kernel, h, serial, table.pair_end, table.pair_j,
+                             table.pair_geometry)
+    np.testing.assert_allclose(serial, expected, rtol=1e-12)
+    np.testing.assert_array_equal(density_pass(moved, box, offset, nlist, kernel, h, 1), serial)
+    for chunks in (2, 3):
+        parallel_table = allocate_pair_table(len(moved), len(nlist.neighbours))
+        np.testing.assert_allclose(
+            density_pass(moved, box, offset, nlist, kernel, h, chunks, parallel_table),
+            serial, rtol=1e-14)
+        np.testing.assert_array_equal(parallel_table.pair_end, table.pair_end)
+    # pair table: exactly the pairs within h, with nearest-image vector, F and image index
+    counts = table.pair_end - nlist.start[:-1]
+    i = np.repeat(np.arange(len(moved)), counts)
+    k = np.concatenate([np.arange(a, b) for a, b in zip(nlist.start[:-1], table.pair_end)])
+    j = table.pair_j[k].astype(np.int64)
+    assert set(zip(i.tolist(), j.tolist())) == {
+        (min(a, b), max(a, b)) for a, b in zip(*np.nonzero(np.triu(r < h, 1)))}
+    rows = table.pair_geometry[k]
+    for a, b, row in zip(i, j, rows):
+        d = moved[a] - moved[b]
+        n = np.rint(d[1] / box[1])
+        shift = [n * offset + box[0] * np.rint((d[0] - n * offset) / box[0]), n * box[1],
+                 box[2] * np.rint(d[2] / box[2]) if dim == 3 else 0.0]
+        np.testing.assert_allclose(row[DX:DZ + 1], d - shift, atol=1e-12)
+        assert row[N_IMAGE] == n
+        assert row[F] == pytest.approx(K.kernel_f(kernel, np.linalg.norm(d - shift), h))
+
+
+@pytest.mark.parametrize("dim,number_density", [(3, 4.096), (2, 4.0)])
+def test_density_on_a_lattice(dim, number_density):
+    spacing = number_density ** (-1 / dim)
+    cells = 6 if dim == 3 else 8
+    length = cells * spacing
+    box = np.array([length, length, length if dim == 3 else 1.0])
+    axes = [np.arange(cells) * spacing + 0.1] * dim + [np.zeros(1)] * (3 - dim)
+    positions = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3)
+    kernel = K.LUCY_3D if dim == 3 else K.LUCY_2D
+    # exact lattice sum Σ_R W(|R|) over lattice vectors
+    m = np.arange(-3, 4) * spacing
+    vectors = np.stack(np.meshgrid(*([m] * dim), indexing="ij"), -1).reshape(-1, dim)
+    lattice_sum = sum(K.kernel_w(kernel, float(np.linalg.norm(v)), 1.0) for v in vectors)
+    assert lattice_sum / number_density == pytest.approx(1.0, abs=0.021)
+    offset = 3 * spacing  # Lees–Edwards offset by whole lattice rows, not whole cells
+    nlist, _ = build(positions, box, dim, offset, skin=0.2)
+    for chunks in (1, 2):
+        density = density_pass(positions, box, offset, nlist, kernel, 1.0, chunks)
+        np.testing.assert_allclose(density, lattice_sum, rtol=1e-12)
+
+
+def test_density_rejects_1d_kernel():
+    rng = np.random.default_rng(12)
+    box, positions = scene("random", (4.0, 4.0, 4.0), 3, rng)
+    nlist, _ = build(positions, box, 3, 0.0)
+    with pytest.raises(ValueError, match="2D and 3D"):
+        density_pass(positions, box, 0.0, nlist, K.QUINTIC_1D, 1.0)
+
+
+def test_parallel_density_independent_of_threads():
+    rng = np.random.default_rng(10)
+    box, positions = scene("random", (4.0, 4.0, 4.0), 3, rng)
+    nlist, _ = build(positions, box, 3, 0.7, skin=0.1)
+    results = []
+    for threads in {1, numba.config.NUMBA_NUM_THREADS}:
+        numba.set_num_threads(threads)
+        results.append(density_pass(positions, box, 0.7, nlist, K.LUCY_3D, 1.0, 2))
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    np.testing.assert_array_equal(results[0], results[-1])
+    assert math.isfinite(results[0].sum())
