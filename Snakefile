@@ -12,6 +12,7 @@ report: "workflow/report/workflow.rst"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/fit.smk"
+include: "workflow/rules/predict.smk"
 
 
 rule all:

@@ -64,5 +64,10 @@ def fit_sample(wildcards):
     return MATERIALS[wildcards.material]["matrix"]["sample"]
 
 
+def volume_fractions(wildcards):
+    return MATERIALS[wildcards.material].get("volume_fractions") or config["homogenisation"]["volume_fractions"]
+
+
 def all_outputs():
-    return [str(RESULTS / m / name) for m in MATERIALS for name in ("fit.json", "fit.png")]
+    names = ("fit.json", "fit.png", "homogenisation.nc", "homogenisation.png")
+    return [str(RESULTS / m / name) for m in MATERIALS for name in names]
