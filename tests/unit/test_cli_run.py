@@ -1,0 +1,135 @@
+"""`suspsim run` and `suspsim bench`: exit codes, one-line errors, nothing written on failure."""
+import importlib.util
+import json
+import signal
+import subprocess
+import sys
+import types
+
+import numba
+import pytest
+
+import suspsim.run as run_module
+from suspsim.cli import main
+from suspsim.io.netcdf import read_run
+from test_run_loop import FakeSimulation, fake
+
+HAVE_SOLVER = importlib.util.find_spec("suspsim.sph.simulation") is not None
+HAVE_BENCH = importlib.util.find_spec("suspsim.sph.bench") is not None
+
+SCENE = """\
+dimension: 2
+box: [{side}, {side}]
+number_density: 4
+fluid: {{law: newtonian, params: {{mu: 2.0}}}}
+flow: {{type: couette, shear_rate: {rate}}}
+run: {{strain: {strain}, transient: {transient}}}
+seed: 3
+"""
+
+
+def write_scene(tmp_path, side=4, rate=0.5, strain=20, transient=4, name="scene.yaml"):
+    path = tmp_path / name
+    path.write_text(SCENE.format(side=side, rate=rate, strain=strain, transient=transient))
+    return path
+
+
+def suspsim(*args, cwd, timeout=None):
+    return subprocess.run([sys.executable, "-m", "suspsim", "-q", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+BAD_SCENES = [
+    (lambda text: text.replace("shear_rate: 0.5", "shear_rate: 0"), "[key 'flow.shear_rate']"),
+    (lambda text: text.replace("seed: 3", "sead: 3"), "sead"),
+    (lambda text: text.replace("strain: 20", "strain: -1"), "[key 'run.strain']"),
+]
+
+
+def test_bad_scene_one_line_exit_1_nothing_written(tmp_path):
+    path = write_scene(tmp_path)
+    edit, expected = BAD_SCENES[0]
+    path.write_text(edit(path.read_text()))
+    proc = suspsim("run", path, "--out", tmp_path / "out" / "run.nc", cwd=tmp_path)
+    assert proc.returncode == 1
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert "scene.yaml:5" in lines[0] and expected in lines[0] and "Traceback" not in proc.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.yaml"]
+
+
+@pytest.mark.parametrize("edit, expected", BAD_SCENES[1:])
+def test_more_bad_scenes_in_process(tmp_path, capsys, edit, expected):
+    path = write_scene(tmp_path)
+    path.write_text(edit(path.read_text()))
+    assert main(["-q", "run", str(path), "--out", str(tmp_path / "run.nc")]) == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and "scene.yaml" in lines[0] and expected in lines[0]
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.yaml"]
+
+
+def test_run_exit_codes_with_a_fake_solver(tmp_path, monkeypatch, capsys):
+    path, out = write_scene(tmp_path), tmp_path / "run.nc"
+    monkeypatch.setattr(run_module, "_solver", lambda: fake(signal_at=(700, signal.SIGTERM)))
+    assert main(["-q", "run", str(path), "--out", str(out)]) == 143
+    err = capsys.readouterr().err
+    assert "interrupted at strain" in err and "--resume" in err and not out.exists()
+    monkeypatch.setattr(run_module, "_solver", lambda: FakeSimulation)
+    assert main(["-q", "run", str(path), "--out", str(out), "--resume", "--threads", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert f"viscosity {float(read_run(out)['viscosity']):.6g} ± " in printed
+    assert str(out) in printed
+    monkeypatch.setattr(run_module, "_solver", lambda: fake(blowup_step=50))
+    assert main(["-q", "run", str(path), "--out", str(tmp_path / "bad.nc")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "numerical failure" in err[0] and "run.max_density_error" in err[0]
+    assert not (tmp_path / "bad.nc").exists()
+
+
+def test_bench_without_the_solver_says_so(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "suspsim.sph.bench", None)
+    assert main(["-q", "bench", "--json"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "suspsim.sph.bench" in err[0] and "not part of" in err[0]
+
+
+def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
+    calls = []
+
+    def benchmark(scene_name, n_steps, threads):
+        calls.append((scene_name, n_steps, threads))
+        return {"scene": scene_name, "n_particles": 4096, "threads": threads, "steps": n_steps,
+                "wall_time_s": 0.5, "particle_steps_per_s": 4096 * n_steps / 0.5, "rebuilds": 3}
+
+    monkeypatch.setitem(sys.modules, "suspsim.sph.bench",
+                        types.SimpleNamespace(benchmark=benchmark))
+    assert main(["-q", "bench", "--steps", "10"]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert len(table) == 3 and "particle-steps/s" in table[0] and "8.19e+04" in table[1]
+    assert [c[0] for c in calls] == ["fluid-newtonian", "fluid-papanastasiou"]
+    assert calls[0][2] == numba.config.NUMBA_NUM_THREADS
+    assert main(["-q", "bench", "--scene", "fluid-papanastasiou", "--threads", "1", "--json"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert rows == [benchmark("fluid-papanastasiou", 200, 1)]
+
+
+@pytest.mark.skipif(not HAVE_SOLVER, reason="the SPH solver (suspsim.sph.simulation) is missing")
+def test_tiny_real_couette_runs_end_to_end(tmp_path):
+    path, out = write_scene(tmp_path, side=4, rate=0.5, strain=10, transient=2), tmp_path / "run.nc"
+    proc = suspsim("run", path, "--out", out, "--threads", 1, cwd=tmp_path, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    assert "viscosity" in proc.stdout and "Reynolds number" in proc.stdout
+    result = read_run(out)
+    assert result.attrs["completed"] == 1 and result.attrs["n_particles"] == 64
+    assert 0.5 * 2.0 < float(result["viscosity"]) < 1.5 * 2.0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.nc", "scene.yaml"]
+
+
+@pytest.mark.skipif(not HAVE_BENCH, reason="the SPH benchmark (suspsim.sph.bench) is not there yet")
+def test_bench_json_lines(tmp_path):
+    proc = suspsim("bench", "--scene", "fluid-newtonian", "--steps", 3, "--threads", 1, "--json",
+                   cwd=tmp_path, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    rows = [json.loads(line) for line in proc.stdout.strip().splitlines()]
+    assert len(rows) == 1 and rows[0]["scene"] == "fluid-newtonian" and rows[0]["threads"] == 1
+    assert rows[0]["n_particles"] > 0 and rows[0]["particle_steps_per_s"] > 0
