@@ -302,12 +302,14 @@ def build_neighbour_list(positions, box, offset, cutoff, cells, cell_start, star
 
 
 @njit(cache=True)
-def needs_rebuild(positions, reference, strain, cutoff, skin):
+def needs_rebuild(positions, reference, strain, cutoff, skin, y_origin=0.0):
     """True when a pair beyond r_c at the last build may now be closer than h = r_c − skin.
 
     Criterion (module docstring): |d̃|₁st + |d̃|₂nd > σ_min(A) r_c − h with
-    d̃ = r − r^b − A y^b ê_x and σ_min = √(1 + A²/4) − |A|/2; ``strain`` A = ∫γ̇ dt since the
-    build (0 without shear). Positions must not have been wrapped since the build (a wrapped
+    d̃ = r − r^b − A (y^b − y_0) ê_x and σ_min = √(1 + A²/4) − |A|/2; ``strain`` A = ∫γ̇ dt
+    since the build (0 without shear); ``y_origin`` y_0 the height at rest in the imposed flow
+    γ̇ (y − y_0) (a uniform translation leaves pair vectors unchanged, so any y_0 is exact;
+    the right one keeps the mean flow from counting as displacement). Positions must not have been wrapped since the build (a wrapped
     particle shows a box-sized displacement and simply forces a rebuild).
     """
     a = abs(strain)
@@ -317,7 +319,7 @@ def needs_rebuild(positions, reference, strain, cutoff, skin):
     first2 = 0.0
     second2 = 0.0
     for i in range(positions.shape[0]):
-        dx = positions[i, 0] - reference[i, 0] - strain * reference[i, 1]
+        dx = positions[i, 0] - reference[i, 0] - strain * (reference[i, 1] - y_origin)
         dy = positions[i, 1] - reference[i, 1]
         dz = positions[i, 2] - reference[i, 2]
         d2 = dx * dx + dy * dy + dz * dz

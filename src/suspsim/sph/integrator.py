@@ -1,0 +1,134 @@
+"""Groot–Warren modified velocity Verlet and the compiled step loop (SPEC §2.6; seed 000 Eqs. 21–23).
+
+One step of size δt:
+
+    x(t + δt) = x + v δt + ½ δt² a(t)
+    ṽ         = v + λ δt a(t),  λ = ½
+    a(t + δt) = f(x(t + δt), ṽ)/m          (density → gradient → normalisation → force passes)
+    v(t + δt) = v + ½ δt (a(t) + a(t + δt))
+
+The viscosity update uses ṽ (the gradient pass reads ṽ). The imposed Couette flow is
+γ̇ (y − L_y/2) (``lattice``), at rest at y_0 = L_y/2, the origin of the rebuild criterion. :func:`advance_steps` runs whole steps
+in compiled code and returns early, after the drift of a step, when the neighbour list must be
+rebuilt (``neighbours.needs_rebuild``); the caller rebuilds (wrap, sort, list) and calls again
+with ``resume=True``, which finishes that step. Time is step_count · δt (no drift of round-off).
+
+Symbols: x, v, a positions, velocities, accelerations (N, 3); ṽ predicted velocity; λ the
+Groot–Warren factor; δt time step [τ]; γ̇ imposed shear rate; Δ Lees–Edwards offset.
+"""
+from __future__ import annotations
+
+from numba import njit, prange
+
+from suspsim.sph import JIT_OPTIONS
+from suspsim.sph.boundaries import lees_edwards_offset
+from suspsim.sph.density import summation_density
+from suspsim.sph.neighbours import needs_rebuild
+from suspsim.sph.terms.force_pass import force_finish, force_sums
+from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
+                                             _normalisation_finish)
+
+#: Groot–Warren λ [seed 000 Eq. 23].
+LAMBDA = 0.5
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def drift(positions, velocities, accel, dt):
+    """x += v δt + ½ δt² a."""
+    half = 0.5 * dt * dt
+    for i in prange(positions.shape[0]):
+        for a in range(3):
+            positions[i, a] += velocities[i, a] * dt + half * accel[i, a]
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def predict(velocities, accel, dt, predicted):
+    """ṽ = v + λ δt a."""
+    k = LAMBDA * dt
+    for i in prange(velocities.shape[0]):
+        for a in range(3):
+            predicted[i, a] = velocities[i, a] + k * accel[i, a]
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def kick(velocities, accel, accel_new, dt):
+    """v += ½ δt (a(t) + a(t + δt)); then a(t) ← a(t + δt)."""
+    half = 0.5 * dt
+    for i in prange(velocities.shape[0]):
+        for a in range(3):
+            velocities[i, a] += half * (accel[i, a] + accel_new[i, a])
+            accel[i, a] = accel_new[i, a]
+
+
+@njit(**JIT_OPTIONS)
+def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours,
+                  kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
+                  law_params, newtonian, velocity_gradient, normalise, alpha, beta, bulk_factor,
+                  bulk_gradient, rho, pair_end, pair_j, geometry, gradient, inverse_moment,
+                  moment_trace, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
+                  force_acc, scratch_1, scratch_15, scratch_6, bounds, virial, accel_out):
+    """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
+
+    ``velocity_gradient`` runs the gradient pass (needed by a non-Newtonian law or the
+    normalisation); ``normalise`` the normalisation pass (else μ̂ must equal μ on entry);
+    ``bulk_gradient`` the ∇a sums (B on and μ varying).
+    """
+    shear_ly = shear_rate * box[1]
+    summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
+                      rho, pair_end, pair_j, geometry, scratch_1, bounds)
+    for i in range(rho.shape[0]):
+        rho[i] *= mass
+    if velocity_gradient:
+        _gradient_sums(nl_start, pair_end, pair_j, geometry, predicted, rho, mass, shear_ly,
+                       grad_acc, scratch_15, bounds)
+        _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian, gradient,
+                         inverse_moment, moment_trace, gdot, viscosity)
+    if normalise:
+        _dissipation_sums(nl_start, pair_end, pair_j, geometry, rho, mass, gradient, alpha, beta,
+                          diss_acc, scratch_1, bounds)
+        _normalisation_finish(diss_acc, gradient, moment_trace, viscosity, alpha, beta,
+                              dimension, factor, viscosity_hat)
+    elif not newtonian:
+        viscosity_hat[:] = viscosity
+    force_sums(nl_start, pair_end, pair_j, geometry, predicted, rho, viscosity_hat, mass, rho_eq,
+               c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, force_acc, scratch_6,
+               bounds, virial)
+    force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
+                 body_force, box[1], accel_out)
+
+
+@njit(**JIT_OPTIONS)
+def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, reference,
+                  positions, velocities, accel, predicted, accel_new, box, nl_start,
+                  nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
+                  body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
+                  normalise, alpha, beta, bulk_factor, bulk_gradient, rho, pair_end, pair_j,
+                  geometry, gradient, inverse_moment, moment_trace, gdot, viscosity, factor,
+                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6,
+                  bounds, virial):
+    """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, rebuild?).
+
+    With rebuild? true the drift of step ``step_count + completed + 1`` has been applied and
+    the list must be rebuilt before calling again with ``resume=True`` (module docstring).
+    """
+    done = 0
+    while done < n_steps:
+        time = (step_count + done + 1) * dt
+        if not resume:
+            drift(positions, velocities, accel, dt)
+            if needs_rebuild(positions, reference, shear_rate * (time - build_time), cutoff,
+                             skin, 0.5 * box[1]):
+                return done, True
+        resume = False
+        offset = lees_edwards_offset(shear_rate, box[0], box[1], time)
+        predict(velocities, accel, dt, predicted)
+        accelerations(positions, predicted, box, offset, nl_start, nl_image_start,
+                      nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate, body_force,
+                      dimension, law_code, law_params, newtonian, velocity_gradient, normalise,
+                      alpha, beta, bulk_factor, bulk_gradient, rho, pair_end, pair_j, geometry,
+                      gradient, inverse_moment, moment_trace, gdot, viscosity, factor,
+                      viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
+                      scratch_6, bounds, virial, accel_new)
+        kick(velocities, accel, accel_new, dt)
+        done += 1
+    return done, False

@@ -1,0 +1,288 @@
+"""The SPH fluid simulation: one scene, its particles and buffers, advanced in compiled code.
+
+:class:`Simulation` builds the lattice (``lattice``), picks the sound speed and time step
+(``timestep``, or the scene's values), allocates every buffer once, and advances with the
+Groot–Warren integrator (``integrator``). Only what the scene needs is computed: the velocity
+gradient pass runs for a non-Newtonian law or the dissipation normalisation, the normalisation
+pass when ``numerics.viscous_normalisation`` is on, the ∇a sums when ``numerics.bulk_correction``
+is on and μ varies. Couette flow uses Lees–Edwards boundaries; Poiseuille a periodic box with
+the split body force (SPEC §2.7).
+
+Particles are reordered (cell sort) and wrapped into the box at every neighbour-list rebuild,
+so per-particle arrays have no fixed identity. :meth:`Simulation.state` holds everything needed
+to continue bit for bit, including the positions at the last build (the list is rebuilt from
+them) and the chunk count of the pair passes, which fixes the summation order whatever the
+thread count of the resumed run.
+"""
+from __future__ import annotations
+
+import logging
+
+import numba
+import numpy as np
+
+from suspsim.scene import Scene
+from suspsim.sph import kernels
+from suspsim.sph.boundaries import lees_edwards_offset
+from suspsim.sph.density import allocate_pair_table
+from suspsim.sph.integrator import accelerations, advance_steps
+from suspsim.sph.lattice import imposed_velocity, initial_velocities, lattice_positions
+from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbour_list,
+                                    build_neighbour_list, raise_for_code, rebuild_neighbour_list,
+                                    sort_by_cell)
+from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
+from suspsim.sph.terms.force_pass import FORCE_WIDTH
+from suspsim.sph.terms.velocity_pass import GRADIENT_WIDTH
+from suspsim.sph.terms.viscous import bulk_factor, viscous_weights
+from suspsim.sph.timestep import auto_sound_speed, stable_time_step
+
+log = logging.getLogger(__name__)
+
+#: Verlet skin [h] (list cutoff h + skin) [choice; the foundation's benchmark value].
+SKIN = 0.2
+#: Support radius in scene units.
+SUPPORT = 1.0
+#: Per-particle arrays of :meth:`Simulation.state` (name → attribute).
+_STATE_ARRAYS = {"positions": "_x", "velocities": "_v", "accelerations": "_a",
+                 "density": "_rho", "shear_rate": "_gdot", "viscosity": "_mu",
+                 "normalisation_factor": "_factor", "viscosity_hat": "_mu_hat",
+                 "velocity_gradient": "_gradient", "inverse_moment": "_inverse_moment",
+                 "virial": "_virial", "reference": "_reference"}
+
+
+class Simulation:
+    """An SPH fluid run of ``scene`` (see the module docstring); ``threads`` None: the scene's."""
+
+    def __init__(self, scene: Scene, *, threads: int | None = None, _state: dict | None = None):
+        self.scene = scene
+        requested = threads if threads is not None else scene.run.threads
+        self.threads = int(min(requested or numba.config.NUMBA_NUM_THREADS,
+                               numba.config.NUMBA_NUM_THREADS))
+        self._n_chunks = int(_state["n_chunks"]) if _state is not None else self.threads
+        law = scene.fluid.law
+        self._newtonian = bool(law.is_newtonian)
+        self._normalise = bool(scene.numerics.viscous_normalisation)
+        self._bulk_gradient = bool(scene.numerics.bulk_correction) and not self._newtonian
+        self._velocity_gradient = (not self._newtonian) or self._normalise
+        self._alpha, self._beta = viscous_weights(scene.dimension, scene.numerics.bulk_correction)
+        self._bulk_factor = bulk_factor(scene.dimension)
+        self._box = np.array([*scene.box, *([1.0] if scene.dimension == 2 else [])], dtype=float)
+        self._kernel = kernels.kernel_code(scene.kernel, scene.dimension)
+        self._rate = scene.flow.shear_rate if scene.flow.type == "couette" else 0.0
+        self._body_force = scene.flow.body_force if scene.flow.type == "poiseuille" else 0.0
+        self._mass = scene.mass
+        if _state is None:
+            positions = lattice_positions(scene)
+            velocities = initial_velocities(scene, positions)
+        else:
+            positions, velocities = _state["positions"], _state["velocities"]
+        self.n_particles = int(positions.shape[0])
+        self._rho_eq = self.n_particles * self._mass / scene.volume
+        if _state is None:
+            self.sound_speed = (float(scene.run.sound_speed) if scene.run.sound_speed is not None
+                                else auto_sound_speed(scene))
+            self.dt = (float(scene.run.dt) if scene.run.dt is not None
+                       else stable_time_step(scene, self.sound_speed))
+            self.step_count = 0
+            self._build_time = 0.0
+        else:
+            self.sound_speed = float(_state["sound_speed"])
+            self.dt = float(_state["dt"])
+            self.step_count = int(_state["step_count"])
+            self._build_time = float(_state["build_time"])
+        self.rebuild_count = 0
+        self._allocate(positions, velocities, capacity_factor=1.5)
+        if _state is None:
+            self._rebuild(0.0)
+            self._compute_accelerations(self._v, self._a)
+        else:
+            for name, attribute in _STATE_ARRAYS.items():
+                getattr(self, attribute)[...] = _state[name]
+            self._relist_from_reference()
+        log.info("simulation: %d particles, dt = %.4g, c = %.4g, %d chunk(s) on %d thread(s)",
+                 self.n_particles, self.dt, self.sound_speed, self._n_chunks, self.threads)
+
+    # ------------------------------------------------------------------ set-up
+    def _allocate(self, positions, velocities, capacity_factor: float) -> None:
+        n, t = self.n_particles, self._n_chunks
+        self._x = np.ascontiguousarray(positions, dtype=float).copy()
+        self._v = np.ascontiguousarray(velocities, dtype=float).copy()
+        self._a = np.zeros((n, 3))
+        self._a_new = np.zeros((n, 3))
+        self._v_pred = np.zeros((n, 3))
+        self._rho = np.zeros(n)
+        self._gdot = np.zeros(n)
+        viscosity = float(self.scene.fluid.law.viscosity(0.0))
+        self._mu = np.full(n, viscosity)
+        self._mu_hat = np.full(n, viscosity)
+        self._factor = np.ones(n)
+        self._gradient = np.zeros((n, 9))
+        self._inverse_moment = np.zeros((n, 6))
+        self._moment_trace = np.zeros(n)
+        self._grad_acc = np.zeros(n * GRADIENT_WIDTH)
+        self._diss_acc = np.zeros(n)
+        self._force_acc = np.zeros(n * FORCE_WIDTH)
+        self._scratch_1 = np.zeros((t - 1, n))
+        self._scratch_15 = np.zeros((t - 1, n * GRADIENT_WIDTH))
+        self._scratch_6 = np.zeros((t - 1, n * FORCE_WIDTH))
+        self._bounds = np.zeros(t + 1, dtype=np.int64)
+        self._virial = np.zeros((t, 5))
+        self._allocate_list(capacity_factor)
+
+    def _allocate_list(self, capacity_factor: float) -> None:
+        self._nlist = allocate_neighbour_list(self.n_particles, self._box, SUPPORT, SKIN,
+                                              self.scene.dimension, self.scene.number_density,
+                                              capacity_factor=capacity_factor)
+        self._reference = self._nlist.reference
+        self._table = allocate_pair_table(self.n_particles, self._nlist.neighbours.shape[0])
+        self._capacity_factor = capacity_factor
+
+    def _offset(self, time: float) -> float:
+        return float(lees_edwards_offset(self._rate, self._box[0], self._box[1], time))
+
+    def _rebuild(self, time: float) -> None:
+        """Wrap, sort and list at ``time``; grows the list once per overflow."""
+        while True:
+            try:
+                rebuild_neighbour_list(self._nlist, self._x, self._v, self._box,
+                                       self._offset(time), self._rate,
+                                       particle_arrays=(self._a,))
+                break
+            except NeighbourListOverflowError as err:
+                factor = 1.3 * err.required / err.capacity * self._capacity_factor
+                log.info("neighbour list overflow; capacity factor %.3g", factor)
+                self._allocate_list(factor)
+        self._build_time = time
+        self.rebuild_count += 1
+
+    def _relist_from_reference(self) -> None:
+        """Rebuild the list of the last build from its (sorted) positions, without reordering."""
+        nl, box = self._nlist, self._box
+        sort_by_cell(self._reference, box, nl.cells, nl.cell_of, nl.order, nl.cell_start)
+        if not np.array_equal(nl.order, np.arange(self.n_particles)):
+            raise ValueError("state: the reference positions are not in cell order")
+        code, n_pairs = build_neighbour_list(self._reference, box, self._offset(self._build_time),
+                                             nl.cutoff, nl.cells, nl.cell_start, nl.start,
+                                             nl.image_start, nl.neighbours, True)
+        raise_for_code(code, n_pairs, nl.neighbours.shape[0])
+        nl.n_pairs = int(n_pairs)
+
+    def _physics_args(self):
+        s, nl, tb = self.scene, self._nlist, self._table
+        return (self._box, nl.start, nl.image_start, nl.neighbours, self._kernel, SUPPORT,
+                self._mass, self._rho_eq, self.sound_speed ** 2, self._rate, self._body_force,
+                s.dimension, s.fluid.law.code, s.fluid.law.packed, self._newtonian,
+                self._velocity_gradient, self._normalise, self._alpha, self._beta,
+                self._bulk_factor, self._bulk_gradient, self._rho, tb.pair_end, tb.pair_j,
+                tb.pair_geometry, self._gradient, self._inverse_moment, self._moment_trace,
+                self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
+                self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,
+                self._scratch_6, self._bounds, self._virial)
+
+    def _compute_accelerations(self, predicted, out) -> None:
+        numba.set_num_threads(self.threads)
+        box, *rest = self._physics_args()
+        accelerations(self._x, predicted, box, self._offset(self.time), *rest, out)
+
+    # ------------------------------------------------------------------ API
+    @property
+    def time(self) -> float:
+        """Simulated time step_count · δt [τ]."""
+        return self.step_count * self.dt
+
+    @property
+    def strain(self) -> float:
+        """γ̇ · time for Couette, 0 otherwise."""
+        return self._rate * self.time
+
+    def advance(self, n_steps: int) -> None:
+        """Run ``n_steps`` steps in compiled code; Python only rebuilds the neighbour list."""
+        numba.set_num_threads(self.threads)
+        remaining, resume = int(n_steps), False
+        nl = self._nlist
+        while remaining > 0:
+            box, *physics = self._physics_args()
+            done, rebuild = advance_steps(
+                remaining, resume, self.step_count, self.dt, self._build_time, nl.cutoff,
+                nl.skin, self._reference, self._x, self._v, self._a, self._v_pred, self._a_new,
+                box, *physics)
+            self.step_count += int(done)
+            remaining -= int(done)
+            resume = bool(rebuild)
+            if rebuild:
+                self._rebuild((self.step_count + 1) * self.dt)
+                nl = self._nlist
+
+    def _peculiar(self) -> np.ndarray:
+        """Velocities relative to the imposed flow (positions unwrapped since the last build)."""
+        out = self._v.copy()
+        out[:, 0] -= imposed_velocity(self.scene, self._x[:, 1])
+        return out
+
+    def _density_error(self) -> float:
+        return float(np.max(np.abs(self._rho / self._rho_eq - 1.0)))
+
+    def _mach(self) -> float:
+        peculiar = self._peculiar()
+        return float(np.sqrt(np.max(np.einsum("ij,ij->i", peculiar, peculiar)))
+                     / self.sound_speed)
+
+    def health(self) -> tuple[bool, str]:
+        """(ok, message): NaN/inf, density error and Mach number against the scene's limits."""
+        run = self.scene.run
+        where = f"at step {self.step_count} (time {self.time:.4g})"
+        settings = f"run.dt = {self.dt:.4g}, run.sound_speed = {self.sound_speed:.4g}"
+        if not (np.all(np.isfinite(self._x)) and np.all(np.isfinite(self._v))
+                and np.all(np.isfinite(self._a)) and np.all(np.isfinite(self._rho))):
+            return False, (f"non-finite positions or velocities {where}: the run blew up; lower "
+                           f"run.dt or raise run.sound_speed ({settings})")
+        error = self._density_error()
+        if error > run.max_density_error:
+            return False, (f"density error {error:.3g} exceeds run.max_density_error "
+                           f"{run.max_density_error:g} {where}: raise run.sound_speed or lower "
+                           f"run.dt ({settings})")
+        mach = self._mach()
+        if mach > run.max_mach:
+            return False, (f"Mach number {mach:.3g} exceeds run.max_mach {run.max_mach:g} "
+                           f"{where}: raise run.sound_speed or lower run.dt ({settings})")
+        return True, f"ok {where}: density error {error:.3g}, Mach {mach:.3g}"
+
+    def sample(self) -> dict[str, float]:
+        """Instantaneous scalars: shear_stress σ_xy, pressure tr Π/d, kinetic_energy of ṽ,
+        density_error, mach (SPEC §2.8)."""
+        peculiar = self._peculiar()
+        pi = pressure_tensor(self._virial, peculiar, self._mass, self.scene.volume)
+        return {"shear_stress": shear_stress(pi),
+                "pressure": mean_pressure(pi, self.scene.dimension),
+                "kinetic_energy": 0.5 * self._mass * float(np.sum(peculiar * peculiar)),
+                "density_error": self._density_error(), "mach": self._mach()}
+
+    def profiles(self, bins: int) -> dict[str, np.ndarray]:
+        """Bin means over y ∈ [0, L_y): y, velocity_profile (v_x), viscosity_profile (μ),
+        shear_rate_profile (γ̇; NaN when no gradient pass runs), density_profile (ρ)."""
+        ly = self.scene.box[1]
+        crossings = np.floor(self._x[:, 1] / ly)
+        y = self._x[:, 1] - crossings * ly
+        vx = self._v[:, 0] - crossings * self._rate * ly
+        index = np.minimum((y / ly * bins).astype(np.int64), bins - 1)
+        count = np.bincount(index, minlength=bins).astype(float)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            def mean(values):
+                return np.bincount(index, weights=values, minlength=bins) / count
+            gdot = mean(self._gdot) if self._velocity_gradient else np.full(bins, np.nan)
+            return {"y": (np.arange(bins) + 0.5) * ly / bins, "velocity_profile": mean(vx),
+                    "viscosity_profile": mean(self._mu), "shear_rate_profile": gdot,
+                    "density_profile": mean(self._rho)}
+
+    def state(self) -> dict[str, np.ndarray | float | int]:
+        """Everything needed to resume bit for bit (copies)."""
+        out = {name: getattr(self, attribute).copy() for name, attribute in _STATE_ARRAYS.items()}
+        out.update(time=self.time, step_count=self.step_count, dt=self.dt,
+                   sound_speed=self.sound_speed, build_time=self._build_time,
+                   n_chunks=self._n_chunks)
+        return out
+
+    @classmethod
+    def from_state(cls, scene: Scene, state, *, threads: int | None = None) -> "Simulation":
+        """Resume from :meth:`state` (same scene); results continue bit for bit."""
+        return cls(scene, threads=threads, _state=state)

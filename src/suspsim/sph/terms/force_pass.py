@@ -1,0 +1,153 @@
+"""Force pass: pressure + viscous (A + B^c) pair forces, ∇a sums and the stress virial.
+
+One pass over the step's pair table (pattern of ``density``: half table, T chunks, chunk 0 into
+the output, chunk c ≥ 1 into ``scratch[c − 1]``). Per pair (i, j), r = r_ij, v = ṽ_ij (with the
+Lees–Edwards correction v_x −= n γ̇ L_y):
+
+    f_ij = m² (P_i/ρ_i² + P_j/ρ_j²) F r                         (``pressure``, SPEC §2.2)
+         − (μ̂_i + μ̂_j) m² F/(ρ_i ρ_j) [α (r·v) r/r² + β v]      (``viscous``, SPEC §2.3–2.4)
+
+added to i and subtracted from j (antisymmetric: momentum conserved to round-off). With the
+bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
+∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
+explicit term ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k is added per particle afterwards; it has no pair
+form and is left out of the virial (it vanishes in simple shear and plane Poiseuille).
+
+The virial Σ_pairs f_ij,a r_ij,b (½ Σ_i Σ_j of SPEC §2.8 over the half table) is summed per
+chunk into ``virial[c]`` = (xx, yy, zz, xy, yx); ``stress`` turns it into Π and σ = −Π.
+Accelerations: a_i = (Σ_j f_ij)/m + body force + explicit ∇a term.
+
+Symbols: P pressure, ρ density, ρ_eq N m/V, c² squared sound speed, μ̂ normalised viscosity,
+a = −(1 + 2/d) μ̂ bulk parameter, (α, β) weights (``viscous``), g body acceleration
+(Poiseuille: +g for y mod L_y < L_y/2, −g above; SPEC §2.7), m particle mass.
+"""
+from __future__ import annotations
+
+import math
+
+from numba import njit, prange
+
+from suspsim.sph import JIT_OPTIONS
+from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
+from suspsim.sph.terms.pressure import equation_of_state, pressure_pair
+from suspsim.sph.terms.viscous import explicit_bulk_term, pair_viscosity, viscous_pair
+
+#: Values per particle in the force accumulator: force (3), then Σ V_j F (a_i − a_j) r (3).
+FORCE_WIDTH = 6
+#: Columns of a chunk's virial row.
+VXX, VYY, VZZ, VXY, VYX = range(5)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscosity, mass,
+                rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc, virial_row):
+    """acc[6 i ...] += forces (and ∇a sums) of particles lo..hi−1, both ends; virial_row +=."""
+    sxx = syy = szz = sxy = syx = 0.0
+    for i in range(lo, hi):
+        rho_i = rho[i]
+        p_i = equation_of_state(rho_i, rho_eq, c2)
+        mu_i = viscosity[i]
+        a_i = bulk_factor * mu_i
+        vol_i = mass / rho_i
+        vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
+        fxi = fyi = fzi = 0.0
+        gxi = gyi = gzi = 0.0
+        for k in range(start[i], pair_end[i]):
+            j = pair_j[k]
+            row = geometry[k]
+            dx, dy, dz, f = row[0], row[1], row[2], row[3]
+            r2 = dx * dx + dy * dy + dz * dz
+            vx = vxi - velocity[j, 0] - row[4] * shear_ly
+            vy = vyi - velocity[j, 1]
+            vz = vzi - velocity[j, 2]
+            rho_j = rho[j]
+            kp = pressure_pair(p_i, rho_i, equation_of_state(rho_j, rho_eq, c2), rho_j, mass, f)
+            wx, wy, wz = viscous_pair(pair_viscosity(mu_i, viscosity[j]), mass * mass * f / (rho_i * rho_j),
+                                      dx, dy, dz, r2, vx, vy, vz, alpha, beta)
+            fx = kp * dx + wx
+            fy = kp * dy + wy
+            fz = kp * dz + wz
+            fxi += fx
+            fyi += fy
+            fzi += fz
+            b = FORCE_WIDTH * j
+            acc[b] -= fx
+            acc[b + 1] -= fy
+            acc[b + 2] -= fz
+            sxx += fx * dx
+            syy += fy * dy
+            szz += fz * dz
+            sxy += fx * dy
+            syx += fy * dx
+            if bulk_gradient:
+                t = f * (a_i - bulk_factor * viscosity[j])
+                tj = t * mass / rho_j
+                gxi += tj * dx
+                gyi += tj * dy
+                gzi += tj * dz
+                ti = t * vol_i
+                acc[b + 3] += ti * dx
+                acc[b + 4] += ti * dy
+                acc[b + 5] += ti * dz
+        b = FORCE_WIDTH * i
+        acc[b] += fxi
+        acc[b + 1] += fyi
+        acc[b + 2] += fzi
+        acc[b + 3] += gxi
+        acc[b + 4] += gyi
+        acc[b + 5] += gzi
+    virial_row[VXX] = sxx
+    virial_row[VYY] = syy
+    virial_row[VZZ] = szz
+    virial_row[VXY] = sxy
+    virial_row[VYX] = syx
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def force_sums(start, pair_end, pair_j, geometry, velocity, rho, viscosity, mass, rho_eq, c2,
+               alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc, scratch, bounds, virial):
+    """acc (6 N,) = pair forces and ∇a sums of every particle; virial (T, 5) per chunk."""
+    n_chunks = scratch.shape[0] + 1
+    chunk_bounds(start, n_chunks, bounds)
+    for c in prange(n_chunks):
+        lo, hi = bounds[c], bounds[c + 1]
+        if c == 0:
+            acc[:] = 0.0
+            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscosity,
+                        mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc,
+                        virial[0])
+        else:
+            buffer = scratch[c - 1]
+            buffer[FORCE_WIDTH * lo:] = 0.0
+            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscosity,
+                        mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
+                        buffer, virial[c])
+    add_chunk_buffers(acc, scratch, bounds, n_chunks, FORCE_WIDTH)
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def force_finish(acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient, body_force,
+                 ly, accel):
+    """a_i = F_i/m + body force + explicit ∇a term (module docstring)."""
+    half = 0.5 * ly
+    for i in prange(accel.shape[0]):
+        b = FORCE_WIDTH * i
+        ax = acc[b] / mass
+        ay = acc[b + 1] / mass
+        az = acc[b + 2] / mass
+        if body_force != 0.0:
+            y = positions[i, 1] - ly * math.floor(positions[i, 1] / ly)
+            ax += body_force if y < half else -body_force
+        if bulk_gradient:
+            m = inverse_moment[i]
+            sx, sy, sz = acc[b + 3], acc[b + 4], acc[b + 5]
+            gax = m[0] * sx + m[3] * sy + m[4] * sz
+            gay = m[3] * sx + m[1] * sy + m[5] * sz
+            gaz = m[4] * sx + m[5] * sy + m[2] * sz
+            ex, ey, ez = explicit_bulk_term(gax, gay, gaz, gradient[i], rho[i])
+            ax += ex
+            ay += ey
+            az += ez
+        accel[i, 0] = ax
+        accel[i, 1] = ay
+        accel[i, 2] = az

@@ -1,0 +1,214 @@
+"""Velocity-gradient pass (γ̇, μ) and dissipation-normalisation pass over the pair table.
+
+Both follow the pattern of ``density`` (read it first): half pair table, particles split into
+T chunks of equal pair count, chunk 0 accumulating into the output, chunk c ≥ 1 into its row of
+``scratch``, rows added by ``add_chunk_buffers``; no allocation, results independent of thread
+scheduling. Velocities are the predicted ṽ of the integrator (the viscosity update uses ṽ,
+SPEC §2.6); a pair across a sheared face has v_ij,x −= n γ̇ L_y (SPEC §2.7).
+
+Pass 1 (:func:`gradient_pass`): per particle G (9) and M2 (6) (``gradient``), then per particle
+g = M2⁻¹ G, γ̇ and, for a non-Newtonian law, μ = viscosity_kernel(code, params, γ̇).
+Pass 2 (:func:`normalisation_pass`): D_i = Σ_j V_j F q(g_i, r_ij) (``normalisation``), then
+s_i and μ̂_i = μ_i/s_i. Without the normalisation μ̂ = μ and pass 2 is skipped.
+
+Symbols: V_j = m/ρ_j particle volume [h^d]; ``shear_ly`` γ̇ L_y, the velocity jump across the
+sheared faces [h τ^−1]; the other symbols as in ``gradient`` and ``normalisation``.
+"""
+from __future__ import annotations
+
+from numba import njit, prange
+
+from suspsim.rheology.laws import viscosity_kernel
+from suspsim.sph import JIT_OPTIONS
+from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
+from suspsim.sph.terms.gradient import XX, YY, ZZ, corrected_gradient, invert_symmetric, shear_rate
+from suspsim.sph.terms.normalisation import (continuum_dissipation, normalisation_factor,
+                                             pair_dissipation)
+
+#: Values per particle accumulated by the gradient pass: G (9) then M2 (xx, yy, zz, xy, xz, yz).
+GRADIENT_WIDTH = 15
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly,
+                   acc):
+    """acc[15 i ...] += (G, M2) of particles lo..hi−1, both ends of each pair."""
+    for i in range(lo, hi):
+        vol_i = mass / rho[i]
+        vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
+        g0 = g1 = g2 = g3 = g4 = g5 = g6 = g7 = g8 = 0.0
+        mxx = myy = mzz = mxy = mxz = myz = 0.0
+        for k in range(start[i], pair_end[i]):
+            j = pair_j[k]
+            row = geometry[k]
+            dx, dy, dz, f = row[0], row[1], row[2], row[3]
+            vx = vxi - velocity[j, 0] - row[4] * shear_ly
+            vy = vyi - velocity[j, 1]
+            vz = vzi - velocity[j, 2]
+            fi = f * vol_i
+            fj = f * mass / rho[j]
+            a0, a1, a2 = dx * vx, dx * vy, dx * vz
+            a3, a4, a5 = dy * vx, dy * vy, dy * vz
+            a6, a7, a8 = dz * vx, dz * vy, dz * vz
+            bxx, byy, bzz = dx * dx, dy * dy, dz * dz
+            bxy, bxz, byz = dx * dy, dx * dz, dy * dz
+            g0 += fj * a0
+            g1 += fj * a1
+            g2 += fj * a2
+            g3 += fj * a3
+            g4 += fj * a4
+            g5 += fj * a5
+            g6 += fj * a6
+            g7 += fj * a7
+            g8 += fj * a8
+            mxx += fj * bxx
+            myy += fj * byy
+            mzz += fj * bzz
+            mxy += fj * bxy
+            mxz += fj * bxz
+            myz += fj * byz
+            b = 15 * j
+            acc[b] += fi * a0
+            acc[b + 1] += fi * a1
+            acc[b + 2] += fi * a2
+            acc[b + 3] += fi * a3
+            acc[b + 4] += fi * a4
+            acc[b + 5] += fi * a5
+            acc[b + 6] += fi * a6
+            acc[b + 7] += fi * a7
+            acc[b + 8] += fi * a8
+            acc[b + 9] += fi * bxx
+            acc[b + 10] += fi * byy
+            acc[b + 11] += fi * bzz
+            acc[b + 12] += fi * bxy
+            acc[b + 13] += fi * bxz
+            acc[b + 14] += fi * byz
+        b = 15 * i
+        acc[b] += g0
+        acc[b + 1] += g1
+        acc[b + 2] += g2
+        acc[b + 3] += g3
+        acc[b + 4] += g4
+        acc[b + 5] += g5
+        acc[b + 6] += g6
+        acc[b + 7] += g7
+        acc[b + 8] += g8
+        acc[b + 9] += mxx
+        acc[b + 10] += myy
+        acc[b + 11] += mzz
+        acc[b + 12] += mxy
+        acc[b + 13] += mxz
+        acc[b + 14] += myz
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def _gradient_sums(start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly, acc,
+                   scratch, bounds):
+    """acc (15 N,) = (G, M2) of every particle, T = scratch.shape[0] + 1 chunks."""
+    n_chunks = scratch.shape[0] + 1
+    chunk_bounds(start, n_chunks, bounds)
+    for c in prange(n_chunks):
+        lo, hi = bounds[c], bounds[c + 1]
+        if c == 0:
+            acc[:] = 0.0
+            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mass,
+                           shear_ly, acc)
+        else:
+            buffer = scratch[c - 1]
+            buffer[GRADIENT_WIDTH * lo:] = 0.0
+            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mass,
+                           shear_ly, buffer)
+    add_chunk_buffers(acc, scratch, bounds, n_chunks, GRADIENT_WIDTH)
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def _gradient_finish(acc, dimension, law_code, law_params, newtonian, gradient, inverse_moment,
+                     moment_trace, gdot, viscosity):
+    """Per particle: g = M2⁻¹ G, tr M2, γ̇ and (non-Newtonian) μ(γ̇) [SPEC §2.5, §1.1]."""
+    for i in prange(gradient.shape[0]):
+        sums = acc[GRADIENT_WIDTH * i:GRADIENT_WIDTH * (i + 1)]
+        moment = sums[9:]
+        moment_trace[i] = moment[XX] + moment[YY] + moment[ZZ]
+        if dimension == 2:
+            moment[ZZ] = 1.0
+        minv = inverse_moment[i]
+        invert_symmetric(moment, minv)
+        g = gradient[i]
+        corrected_gradient(minv, sums, g)
+        rate = shear_rate(g)
+        gdot[i] = rate
+        if not newtonian:
+            viscosity[i] = viscosity_kernel(law_code, law_params, rate)
+
+
+def gradient_pass(start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly, dimension,
+                  law_code, law_params, newtonian, acc, scratch, bounds, gradient,
+                  inverse_moment, moment_trace, gdot, viscosity):
+    """Python entry of pass 1 (the integrator calls the two compiled halves directly)."""
+    _gradient_sums(start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly, acc,
+                   scratch, bounds)
+    _gradient_finish(acc, dimension, law_code, law_params, newtonian, gradient, inverse_moment,
+                     moment_trace, gdot, viscosity)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, rho, mass, gradient, alpha,
+                      beta, acc):
+    """acc[i] += Σ_j V_j F q(g_i, r_ij) for particles lo..hi−1, both ends of each pair."""
+    for i in range(lo, hi):
+        vol_i = mass / rho[i]
+        gi = gradient[i]
+        own = 0.0
+        for k in range(start[i], pair_end[i]):
+            j = pair_j[k]
+            row = geometry[k]
+            dx, dy, dz, f = row[0], row[1], row[2], row[3]
+            r2 = dx * dx + dy * dy + dz * dz
+            own += f * mass / rho[j] * pair_dissipation(gi, dx, dy, dz, r2, alpha, beta)
+            acc[j] += f * vol_i * pair_dissipation(gradient[j], dx, dy, dz, r2, alpha, beta)
+        acc[i] += own
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def _dissipation_sums(start, pair_end, pair_j, geometry, rho, mass, gradient, alpha, beta, acc,
+                      scratch, bounds):
+    """acc (N,) = discrete dissipation D_i of every particle's local linear field."""
+    n_chunks = scratch.shape[0] + 1
+    chunk_bounds(start, n_chunks, bounds)
+    for c in prange(n_chunks):
+        lo, hi = bounds[c], bounds[c + 1]
+        if c == 0:
+            acc[:] = 0.0
+            _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, rho, mass, gradient,
+                              alpha, beta, acc)
+        else:
+            buffer = scratch[c - 1]
+            buffer[lo:] = 0.0
+            _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, rho, mass, gradient,
+                              alpha, beta, buffer)
+    add_chunk_buffers(acc, scratch, bounds, n_chunks, 1)
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def _normalisation_finish(acc, gradient, moment_trace, viscosity, alpha, beta, dimension, factor,
+                          viscosity_hat):
+    """s_i = D_i/D_c (``normalisation``) and μ̂_i = μ_i/s_i."""
+    for i in prange(viscosity.shape[0]):
+        g = gradient[i]
+        norm2 = 0.0
+        for k in range(9):
+            norm2 += g[k] * g[k]
+        s = normalisation_factor(acc[i], continuum_dissipation(g, alpha, beta, dimension), norm2,
+                                 moment_trace[i], dimension)
+        factor[i] = s
+        viscosity_hat[i] = viscosity[i] / s
+
+
+def normalisation_pass(start, pair_end, pair_j, geometry, rho, mass, gradient, moment_trace,
+                       viscosity, alpha, beta, dimension, acc, scratch, bounds, factor,
+                       viscosity_hat):
+    """Python entry of pass 2 (the integrator calls the two compiled halves directly)."""
+    _dissipation_sums(start, pair_end, pair_j, geometry, rho, mass, gradient, alpha, beta, acc,
+                      scratch, bounds)
+    _normalisation_finish(acc, gradient, moment_trace, viscosity, alpha, beta, dimension, factor,
+                          viscosity_hat)

@@ -1,0 +1,83 @@
+"""Viscous pair force (A and the symmetrised bulk correction B^c) and the explicit ∇a term.
+
+SPEC §2.3 (seed 000 Eqs. 9–12, sign derived) gives the pair form of A,
+    f^A_ij = −(d + 2) m² F/(ρ_i ρ_j) (μ_i + μ_j) (r·v) r / r²,
+and SPEC §2.4 with the probe's symmetrisation (a_i + a_j)/2 gives the pair form of B^c,
+    f^B_ij = m² F/(ρ_i ρ_j) ā [v − (d + 2)(r·v) r / r²],   ā = (a_i + a_j)/2,
+with a = ζ − (1 + 2/d) μ and ζ = 0 (seed 000), r = r_ij, v = v_ij. Both are antisymmetric, so
+momentum is conserved to round-off. Together (ā = −(1 + 2/d)(μ_i + μ_j)/2):
+    f_ij = −(μ_i + μ_j) m² F/(ρ_i ρ_j) [α (r·v) r / r² + β v]
+with (α, β) = (d + 2, 0) without B and ((d + 2)(d − 2)/(2d), (d + 2)/(2d)) with B — in 3D
+(5/6, 5/6), the Español–Revenga form; in 2D (0, 1). Continuum limit of the sum with the B
+correction: ∇·[μ(∇v + ∇vᵀ)] + ∇(a ∇·v) except for ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k, which the
+symmetrisation removes and :func:`explicit_bulk_term` adds back per particle [SPEC §2.3,
+derived; zero in simple shear and plane Poiseuille].
+
+Symbols:
+
+====== ====================================================== ==================
+symbol meaning                                                unit
+====== ====================================================== ==================
+μ      (normalised) viscosity of a particle                   [m h^(2−d) τ^−1]
+a      bulk parameter ζ − (1 + 2/d) μ, ζ = 0                   [m h^(2−d) τ^−1]
+α, β   weights of (r·v) r / r² and v in the pair force        1
+F      kernel factor −W'/r                                     [h^−(d+2)]
+d      dimension                                               1
+====== ====================================================== ==================
+"""
+from __future__ import annotations
+
+from numba import njit
+
+from suspsim.sph import JIT_OPTIONS
+
+
+def viscous_weights(dimension: int, bulk_correction: bool) -> tuple[float, float]:
+    """(α, β) of the combined pair force for ``dimension`` with or without B (module docstring)."""
+    d = float(dimension)
+    if not bulk_correction:
+        return d + 2.0, 0.0
+    return (d + 2.0) * (d - 2.0) / (2.0 * d), (d + 2.0) / (2.0 * d)
+
+
+def bulk_factor(dimension: int) -> float:
+    """a/μ = −(1 + 2/d) for ζ = 0 [SPEC §2.4; seed 000 takes ζ = 0]."""
+    return -(1.0 + 2.0 / dimension)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def pair_viscosity(mu_i, mu_j):
+    """μ_i + μ_j of seed 000 Eq. 12, taken as twice the harmonic mean 4 μ_i μ_j/(μ_i + μ_j).
+
+    [choice] Equal to μ_i + μ_j to first order in μ_i − μ_j, so the continuum limit (and the
+    explicit ∇a term) is unchanged; across a steep viscosity rise (a yield-stress plug edge)
+    it is the viscosity of two layers sheared in series, where the arithmetic sum lets the
+    stiff particle dominate. Not yet compared with the arithmetic sum at Re ≤ 0.1.
+    """
+    return 4.0 * mu_i * mu_j / (mu_i + mu_j)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def viscous_pair(mu_sum, scale, dx, dy, dz, r2, vx, vy, vz, alpha, beta):
+    """Force on i from j (module docstring): −(μ_i + μ_j) s [α (r·v) r/r² + β v].
+
+    ``scale`` s = m² F/(ρ_i ρ_j); (dx, dy, dz) = r_ij, r2 = |r_ij|² > 0, (vx, vy, vz) = v_ij
+    (with the Lees–Edwards image correction). SPEC §2.3–2.4, seed 000 Eqs. 9–16.
+    """
+    rv = (dx * vx + dy * vy + dz * vz) / r2
+    k = -mu_sum * scale
+    return (k * (alpha * rv * dx + beta * vx), k * (alpha * rv * dy + beta * vy),
+            k * (alpha * rv * dz + beta * vz))
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def explicit_bulk_term(gax, gay, gaz, g, rho):
+    """Acceleration ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k, divided by ρ [SPEC §2.3, derived].
+
+    (gax, gay, gaz) = ∇a; ``g`` the 9 entries g[3k + j] = ∂_k v_j of the corrected gradient.
+    """
+    div = g[0] + g[4] + g[8]
+    ax = 0.5 * (gax * div - (gax * g[0] + gay * g[1] + gaz * g[2])) / rho
+    ay = 0.5 * (gay * div - (gax * g[3] + gay * g[4] + gaz * g[5])) / rho
+    az = 0.5 * (gaz * div - (gax * g[6] + gay * g[7] + gaz * g[8])) / rho
+    return ax, ay, az

@@ -1,0 +1,94 @@
+"""Physics terms as scalar functions: pair antisymmetry, cutoff, weights and continuum values."""
+import math
+
+import numpy as np
+import pytest
+
+from suspsim.sph.kernels import LUCY_2D, LUCY_3D, kernel_f
+from suspsim.sph.terms.gradient import corrected_gradient, invert_symmetric, shear_rate
+from suspsim.sph.terms.normalisation import continuum_dissipation, normalisation_factor
+from suspsim.sph.terms.pressure import equation_of_state, pressure_pair
+from suspsim.sph.terms.viscous import (bulk_factor, explicit_bulk_term, pair_viscosity,
+                                       viscous_pair, viscous_weights)
+
+
+def pair_force(ri, rj, vi, vj, rho_i, rho_j, mu_i, mu_j, dim=3, bulk=True, c2=4.0, h=1.0):
+    """Force on i from j: pressure + viscous (as the force pass combines them)."""
+    d = np.subtract(ri, rj)
+    v = np.subtract(vi, vj)
+    r2 = float(d @ d)
+    f = kernel_f(LUCY_3D if dim == 3 else LUCY_2D, math.sqrt(r2), h)
+    kp = pressure_pair(equation_of_state(rho_i, 4.0, c2), rho_i,
+                       equation_of_state(rho_j, 4.0, c2), rho_j, 1.0, f)
+    alpha, beta = viscous_weights(dim, bulk)
+    w = viscous_pair(pair_viscosity(mu_i, mu_j), f / (rho_i * rho_j), *d, r2, *v, alpha, beta)
+    return kp * d + np.array(w)
+
+
+@pytest.mark.parametrize("bulk", [True, False])
+def test_pair_force_is_antisymmetric_and_vanishes_beyond_the_support(bulk):
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        ri, rj, vi, vj = rng.normal(size=(4, 3)) * [[0.4], [0.4], [1.0], [1.0]]
+        args = (4.1, 3.9, 0.7, 2.3)
+        f_ij = pair_force(ri, rj, vi, vj, *args, bulk=bulk)
+        f_ji = pair_force(rj, ri, vj, vi, 3.9, 4.1, 2.3, 0.7, bulk=bulk)
+        np.testing.assert_allclose(f_ij, -f_ji, rtol=1e-13, atol=1e-15)
+    far = pair_force([0, 0, 0], [1.0, 0, 0], [1, 2, 3], [0, 0, 0], 4.1, 3.9, 1.0, 1.0)
+    assert np.all(far == 0.0)
+    beyond = pair_force([0, 0, 0], [0.8, 0.7, 0], [1, 2, 3], [0, 0, 0], 4.1, 3.9, 1.0, 1.0)
+    assert np.all(beyond == 0.0)
+
+
+def test_viscous_weights_combine_a_and_b_as_derived():
+    # 3D with B: Español–Revenga weights 5/6, 5/6; 2D with B: pure v_ij; without B: (d + 2, 0)
+    assert viscous_weights(3, True) == pytest.approx((5 / 6, 5 / 6))
+    assert viscous_weights(2, True) == pytest.approx((0.0, 1.0))
+    assert viscous_weights(3, False) == (5.0, 0.0)
+    assert bulk_factor(3) == pytest.approx(-5 / 3) and bulk_factor(2) == pytest.approx(-2.0)
+
+
+def test_pair_viscosity_is_the_sum_for_equal_viscosities():
+    assert pair_viscosity(1.5, 1.5) == pytest.approx(3.0)
+    assert pair_viscosity(1.0, 1.1) == pytest.approx(2.1, rel=3e-3)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_continuum_dissipation_of_simple_shear_is_rate_squared_with_b(dim):
+    g = np.zeros(9)
+    g[3] = 0.7  # ∂_y v_x
+    alpha, beta = viscous_weights(dim, True)
+    assert continuum_dissipation(g, alpha, beta, dim) == pytest.approx(0.49)
+
+
+def test_normalisation_factor_falls_back_and_clips():
+    assert normalisation_factor(0.8, 1.0, 1.0, 3.0, 3) == pytest.approx(0.8)
+    assert normalisation_factor(0.0, 0.0, 0.0, 2.7, 3) == pytest.approx(0.9)
+    assert normalisation_factor(100.0, 1.0, 1.0, 3.0, 3) == 4.0
+
+
+def test_shear_rate_is_exact_in_simple_shear_and_zero_in_rotation():
+    g = np.zeros(9)
+    g[3] = 2.5
+    assert shear_rate(g) == pytest.approx(2.5)
+    g[1] = -2.5
+    assert shear_rate(g) == pytest.approx(0.0, abs=1e-15)
+
+
+def test_moment_correction_recovers_the_gradient():
+    rng = np.random.default_rng(0)
+    a = rng.normal(size=(3, 3))
+    m2 = a @ a.T + 3 * np.eye(3)
+    grad = rng.normal(size=(3, 3))
+    packed = np.array([m2[0, 0], m2[1, 1], m2[2, 2], m2[0, 1], m2[0, 2], m2[1, 2]])
+    minv = np.zeros(6)
+    invert_symmetric(packed, minv)
+    out = np.zeros(9)
+    corrected_gradient(minv, (m2 @ grad).ravel(), out)
+    np.testing.assert_allclose(out.reshape(3, 3), grad, rtol=1e-12, atol=1e-12)
+
+
+def test_explicit_bulk_term_vanishes_in_simple_shear_with_gradient_across():
+    g = np.zeros(9)
+    g[3] = 1.0  # ∂_y v_x, ∇a along y
+    assert explicit_bulk_term(0.0, 3.0, 0.0, g, 4.0) == pytest.approx((0.0, 0.0, 0.0))
