@@ -110,13 +110,8 @@ def wrap_3d(x, y, z, vx, lx, ly, lz, offset, shear_rate):
 @njit(cache=True)
 def wrap_2d(x, y, vx, lx, ly, offset, shear_rate):
     """Map a particle into the 2D box; returns (x, y, vx, k), rules as :func:`wrap_3d`."""
-    k = math.floor(y / ly)
-    y -= k * ly
-    if y >= ly:
-        y = ly * (1.0 - 2.220446049250313e-16)
-    x -= k * offset
-    vx -= k * shear_rate * ly
-    return _wrap_periodic(x, lx), y, vx, k
+    x, y, _, vx, k = wrap_3d(x, y, 0.0, vx, lx, ly, 1.0, offset, shear_rate)
+    return x, y, vx, k
 
 
 @njit(cache=True)
