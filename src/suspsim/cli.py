@@ -104,13 +104,8 @@ def _cmd_run(args) -> int:
 def _cmd_bench(args) -> int:
     import json
 
-    try:
-        from .sph.bench import benchmark
-    except ModuleNotFoundError as err:
-        if err.name is None or not err.name.startswith("suspsim.sph"):
-            raise
-        raise InputError("suspsim.sph.bench", "the SPH benchmark is not part of this "
-                         "installation yet; update suspsim") from None
+    from .sph.bench import benchmark
+
     if args.threads is None:
         import numba
 

@@ -287,11 +287,7 @@ def _unflatten(flat: dict[str, Any]) -> dict[str, Any]:
 
 
 def _solver():
-    try:
-        from .sph.simulation import Simulation
-    except ModuleNotFoundError as err:
-        if err.name is None or not err.name.startswith("suspsim.sph"):
-            raise
-        raise InputError("suspsim.sph.simulation", "the SPH solver is not part of this "
-                         "installation yet; update suspsim") from None
+    """The real solver class, imported on first use (numba compilation is slow to load)."""
+    from .sph.simulation import Simulation
+
     return Simulation

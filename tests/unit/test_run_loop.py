@@ -1,6 +1,5 @@
 """The run loop with a fake solver: output, averages, resume after a signal, blow-up, progress."""
 import dataclasses
-import importlib.util
 import io
 import math
 import os
@@ -269,8 +268,6 @@ def test_checkpoint_rules_without_and_with_resume(tmp_path):
         run(tmp_path, the_scene=scene(other), resume=True)
 
 
-@pytest.mark.skipif(importlib.util.find_spec("suspsim.sph.simulation") is None,
-                    reason="the SPH solver (suspsim.sph.simulation) is not there yet")
 def test_the_real_solver_resumes_bit_for_bit(tmp_path):
     from suspsim.sph.simulation import Simulation
 

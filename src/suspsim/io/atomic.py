@@ -40,6 +40,12 @@ def write_json(path: str | os.PathLike, obj) -> None:
         tmp.write_text(text, encoding="utf-8")
 
 
+def save_figure(fig, path: str | os.PathLike, *, dpi: int = 150) -> None:
+    """Save a matplotlib figure atomically; the format follows the suffix (.png, .pdf, .svg)."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+
+
 def _finite_or_none(obj):
     if isinstance(obj, float) and not math.isfinite(obj):
         return None

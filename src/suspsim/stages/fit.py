@@ -6,7 +6,7 @@ import os
 from typing import Sequence
 
 from ..errors import InputError
-from ..io.atomic import atomic_path, write_json
+from ..io.atomic import save_figure, write_json
 from ..rheology.fitting import DEFAULT_CANDIDATES, FitResult, fit_flow_curve
 from ..rheology.laws import LAW_SPECS
 from ..rheology.readers import list_samples, read_flow_curve
@@ -53,9 +53,8 @@ def fit_matrix_file(path: str | os.PathLike, *, law: str = "auto", sample: str |
     if out_plot is not None:
         from ..plotting.flow_curve import plot_fit
 
-        fig = plot_fit(data["shear_rate"].to_numpy(), data["shear_stress"].to_numpy(), result)
-        with atomic_path(out_plot) as tmp:
-            fig.savefig(tmp, dpi=150, bbox_inches="tight")
+        save_figure(plot_fit(data["shear_rate"].to_numpy(), data["shear_stress"].to_numpy(),
+                             result), out_plot)
     if out_json is not None:
         write_json(out_json, result.to_dict())
     return result

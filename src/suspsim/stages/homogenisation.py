@@ -23,7 +23,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import InputError
-from ..io.atomic import atomic_path
+from ..io.atomic import atomic_path, save_figure
 from ..io.provenance import provenance
 from ..rheology.laws import make_law
 from ..rheology.suspension import (chateau_ovarlez_trung_viscosity, krieger_dougherty,
@@ -110,9 +110,7 @@ def write_homogenisation(fit_json: str | os.PathLike, out_nc: str | os.PathLike,
     if out_plot is not None:
         from ..plotting.suspension import plot_homogenisation
 
-        fig = plot_homogenisation(dataset)
-        with atomic_path(out_plot) as tmp:
-            fig.savefig(tmp, dpi=150, bbox_inches="tight")
+        save_figure(plot_homogenisation(dataset), out_plot)
     with atomic_path(out_nc) as tmp:
         dataset.to_netcdf(tmp, engine="netcdf4",
                           encoding={name: {"_FillValue": None} for name in dataset.coords})
