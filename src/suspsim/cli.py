@@ -64,7 +64,9 @@ _BENCH_COLUMNS = (("scene", "scene", "{}"), ("particles", "n_particles", "{}"),
                   ("threads", "threads", "{}"), ("steps", "steps", "{}"),
                   ("wall s", "wall_time_s", "{:.3g}"),
                   ("particle-steps/s", "particle_steps_per_s", "{:.3g}"),
-                  ("rebuilds", "rebuilds", "{}"))
+                  ("rebuilds", "rebuilds", "{}"),
+                  ("viscosity error", "viscosity_error", "{:+.2%}"),
+                  ("density error", "density_error", "{:.2%}"))
 
 
 def _positive_int(text: str) -> int:

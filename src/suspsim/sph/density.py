@@ -146,6 +146,14 @@ def _density_chunk(lo, hi, positions, box, offset, start, image_start, neighbour
         raise ValueError(_KERNEL_ERROR)
 
 
+@njit(parallel=True, **JIT_OPTIONS)
+def mass_density(density, mass, volume):
+    """ρ = m d in place (``density`` holds d on entry) and the particle volumes V = m/ρ = 1/d."""
+    for i in prange(density.shape[0]):
+        volume[i] = 1.0 / density[i]
+        density[i] *= mass
+
+
 @njit(**JIT_OPTIONS)
 def summation_density_serial(positions, box, offset, start, image_start, neighbours, kernel, h,
                              density, pair_end, pair_j, pair_geometry):

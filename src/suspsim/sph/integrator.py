@@ -22,7 +22,7 @@ from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.boundaries import lees_edwards_offset
-from suspsim.sph.density import summation_density
+from suspsim.sph.density import mass_density, summation_density
 from suspsim.sph.neighbours import needs_rebuild
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
@@ -64,9 +64,10 @@ def kick(velocities, accel, accel_new, dt):
 def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours,
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, normalise, alpha, beta, bulk_factor,
-                  bulk_gradient, rho, pair_end, pair_j, geometry, gradient, inverse_moment,
-                  moment_trace, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
-                  force_acc, scratch_1, scratch_15, scratch_6, bounds, virial, accel_out):
+                  bulk_gradient, rho, volume, pressure, pair_end, pair_j, geometry, gradient,
+                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
+                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6,
+                  bounds, virial, accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
 
     ``velocity_gradient`` runs the gradient pass (needed by a non-Newtonian law or the
@@ -76,23 +77,24 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     shear_ly = shear_rate * box[1]
     summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
                       rho, pair_end, pair_j, geometry, scratch_1, bounds)
-    for i in range(rho.shape[0]):
-        rho[i] *= mass
+    mass_density(rho, mass, volume)
     if velocity_gradient:
-        _gradient_sums(nl_start, pair_end, pair_j, geometry, predicted, rho, mass, shear_ly,
+        _gradient_sums(nl_start, pair_end, pair_j, geometry, predicted, volume, shear_ly,
                        grad_acc, scratch_15, bounds)
-        _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian, gradient,
-                         inverse_moment, moment_trace, gdot, viscosity)
+        _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian, normalise, beta,
+                         gradient, inverse_moment, moment_trace, gdot, viscosity, strain,
+                         dissipation)
     if normalise:
-        _dissipation_sums(nl_start, pair_end, pair_j, geometry, rho, mass, gradient, alpha, beta,
-                          diss_acc, scratch_1, bounds)
-        _normalisation_finish(diss_acc, gradient, moment_trace, viscosity, alpha, beta,
-                              dimension, factor, viscosity_hat)
+        if alpha != 0.0:
+            _dissipation_sums(nl_start, pair_end, pair_j, geometry, volume, strain, diss_acc,
+                              scratch_1, bounds)
+        _normalisation_finish(diss_acc, dissipation, gradient, moment_trace, viscosity, alpha,
+                              beta, dimension, factor, viscosity_hat)
     elif not newtonian:
         viscosity_hat[:] = viscosity
-    force_sums(nl_start, pair_end, pair_j, geometry, predicted, rho, viscosity_hat, mass, rho_eq,
-               c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, force_acc, scratch_6,
-               bounds, virial)
+    force_sums(nl_start, pair_end, pair_j, geometry, predicted, rho, volume, viscosity_hat, mass,
+               rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, pressure,
+               force_acc, scratch_6, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
 
@@ -102,10 +104,10 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   positions, velocities, accel, predicted, accel_new, box, nl_start,
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
-                  normalise, alpha, beta, bulk_factor, bulk_gradient, rho, pair_end, pair_j,
-                  geometry, gradient, inverse_moment, moment_trace, gdot, viscosity, factor,
-                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6,
-                  bounds, virial):
+                  normalise, alpha, beta, bulk_factor, bulk_gradient, rho, volume, pressure,
+                  pair_end, pair_j, geometry, gradient, inverse_moment, moment_trace, strain,
+                  dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
+                  force_acc, scratch_1, scratch_15, scratch_6, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, rebuild?).
 
     With rebuild? true the drift of step ``step_count + completed + 1`` has been applied and
@@ -125,10 +127,10 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
         accelerations(positions, predicted, box, offset, nl_start, nl_image_start,
                       nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate, body_force,
                       dimension, law_code, law_params, newtonian, velocity_gradient, normalise,
-                      alpha, beta, bulk_factor, bulk_gradient, rho, pair_end, pair_j, geometry,
-                      gradient, inverse_moment, moment_trace, gdot, viscosity, factor,
-                      viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
-                      scratch_6, bounds, virial, accel_new)
+                      alpha, beta, bulk_factor, bulk_gradient, rho, volume, pressure, pair_end,
+                      pair_j, geometry, gradient, inverse_moment, moment_trace, strain,
+                      dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
+                      force_acc, scratch_1, scratch_15, scratch_6, bounds, virial, accel_new)
         kick(velocities, accel, accel_new, dt)
         done += 1
     return done, False

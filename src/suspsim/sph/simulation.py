@@ -111,6 +111,10 @@ class Simulation:
         self._a_new = np.zeros((n, 3))
         self._v_pred = np.zeros((n, 3))
         self._rho = np.zeros(n)
+        self._volume = np.zeros(n)
+        self._pressure = np.zeros(n)
+        self._strain = np.zeros((n, 6))
+        self._dissipation = np.zeros(n)
         self._gdot = np.zeros(n)
         viscosity = float(self.scene.fluid.law.viscosity(0.0))
         self._mu = np.full(n, viscosity)
@@ -173,8 +177,9 @@ class Simulation:
                 self._mass, self._rho_eq, self.sound_speed ** 2, self._rate, self._body_force,
                 s.dimension, s.fluid.law.code, s.fluid.law.packed, self._newtonian,
                 self._velocity_gradient, self._normalise, self._alpha, self._beta,
-                self._bulk_factor, self._bulk_gradient, self._rho, tb.pair_end, tb.pair_j,
-                tb.pair_geometry, self._gradient, self._inverse_moment, self._moment_trace,
+                self._bulk_factor, self._bulk_gradient, self._rho, self._volume,
+                self._pressure, tb.pair_end, tb.pair_j, tb.pair_geometry, self._gradient,
+                self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
                 self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
                 self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,
                 self._scratch_6, self._bounds, self._virial)

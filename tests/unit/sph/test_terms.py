@@ -6,8 +6,10 @@ import pytest
 
 from suspsim.sph.kernels import LUCY_2D, LUCY_3D, kernel_f
 from suspsim.sph.terms.gradient import corrected_gradient, invert_symmetric, shear_rate
-from suspsim.sph.terms.normalisation import continuum_dissipation, normalisation_factor
-from suspsim.sph.terms.pressure import equation_of_state, pressure_pair
+from suspsim.sph.terms.normalisation import (continuum_dissipation, moment_dissipation,
+                                             normalisation_factor, pair_dissipation,
+                                             quadratic_form, strain_form)
+from suspsim.sph.terms.pressure import equation_of_state, pressure_pair, pressure_term
 from suspsim.sph.terms.viscous import (bulk_factor, explicit_bulk_term, pair_viscosity,
                                        viscous_pair, viscous_weights)
 
@@ -18,8 +20,7 @@ def pair_force(ri, rj, vi, vj, rho_i, rho_j, mu_i, mu_j, dim=3, bulk=True, c2=4.
     v = np.subtract(vi, vj)
     r2 = float(d @ d)
     f = kernel_f(LUCY_3D if dim == 3 else LUCY_2D, math.sqrt(r2), h)
-    kp = pressure_pair(equation_of_state(rho_i, 4.0, c2), rho_i,
-                       equation_of_state(rho_j, 4.0, c2), rho_j, 1.0, f)
+    kp = pressure_pair(pressure_term(rho_i, 4.0, c2, 1.0), pressure_term(rho_j, 4.0, c2, 1.0), f)
     alpha, beta = viscous_weights(dim, bulk)
     w = viscous_pair(pair_viscosity(mu_i, mu_j), f / (rho_i * rho_j), *d, r2, *v, alpha, beta)
     return kp * d + np.array(w)
@@ -59,6 +60,23 @@ def test_continuum_dissipation_of_simple_shear_is_rate_squared_with_b(dim):
     g[3] = 0.7  # ∂_y v_x
     alpha, beta = viscous_weights(dim, True)
     assert continuum_dissipation(g, alpha, beta, dim) == pytest.approx(0.49)
+
+
+def test_split_dissipation_equals_the_pair_form():
+    """α Σ w (r·S r)²/r² + β (L Lᵀ):M2 (what the pass computes) = Σ w pair_dissipation."""
+    rng = np.random.default_rng(5)
+    g = rng.normal(size=9)
+    r = rng.normal(size=(40, 3))
+    w = rng.uniform(0.5, 2.0, size=40)
+    alpha, beta = 0.7, 1.3
+    pair = sum(wk * pair_dissipation(g, *rk, rk @ rk, alpha, beta) for wk, rk in zip(w, r))
+    s = np.zeros(6)
+    strain_form(g, s)
+    quartic = sum(wk * quadratic_form(s, x * x, y * y, z * z, x * y, x * z, y * z) ** 2 / (rk @ rk)
+                  for wk, rk in zip(w, r) for x, y, z in [rk])
+    m2 = np.einsum("k,ki,kj->ij", w, r, r)
+    moment = np.array([m2[0, 0], m2[1, 1], m2[2, 2], m2[0, 1], m2[0, 2], m2[1, 2]])
+    assert alpha * quartic + beta * moment_dissipation(g, moment) == pytest.approx(pair, rel=1e-12)
 
 
 def test_normalisation_factor_falls_back_and_clips():

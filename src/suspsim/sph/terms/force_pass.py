@@ -7,7 +7,7 @@ Lees–Edwards correction v_x −= n γ̇ L_y):
     f_ij = m² (P_i/ρ_i² + P_j/ρ_j²) F r                         (``pressure``, SPEC §2.2)
          − (μ̂_i + μ̂_j) m² F/(ρ_i ρ_j) [α (r·v) r/r² + β v]      (``viscous``, SPEC §2.3–2.4)
 
-added to i and subtracted from j (antisymmetric: momentum conserved to round-off). With the
+with m² F/(ρ_i ρ_j) = F V_i V_j from the step's volumes V = m/ρ, added to i and subtracted from j (antisymmetric: momentum conserved to round-off). With the
 bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
 ∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
 explicit term ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k is added per particle afterwards; it has no pair
@@ -29,7 +29,7 @@ from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
-from suspsim.sph.terms.pressure import equation_of_state, pressure_pair
+from suspsim.sph.terms.pressure import pressure_pair, pressure_term
 from suspsim.sph.terms.viscous import explicit_bulk_term, pair_viscosity, viscous_pair
 
 #: Values per particle in the force accumulator: force (3), then Σ V_j F (a_i − a_j) r (3).
@@ -39,16 +39,15 @@ VXX, VYY, VZZ, VXY, VYX = range(5)
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscosity, mass,
-                rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc, virial_row):
+def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure, viscosity,
+                alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc, virial_row):
     """acc[6 i ...] += forces (and ∇a sums) of particles lo..hi−1, both ends; virial_row +=."""
     sxx = syy = szz = sxy = syx = 0.0
     for i in range(lo, hi):
-        rho_i = rho[i]
-        p_i = equation_of_state(rho_i, rho_eq, c2)
+        p_i = pressure[i]
         mu_i = viscosity[i]
         a_i = bulk_factor * mu_i
-        vol_i = mass / rho_i
+        vol_i = volume[i]
         vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
         fxi = fyi = fzi = 0.0
         gxi = gyi = gzi = 0.0
@@ -60,9 +59,9 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscos
             vx = vxi - velocity[j, 0] - row[4] * shear_ly
             vy = vyi - velocity[j, 1]
             vz = vzi - velocity[j, 2]
-            rho_j = rho[j]
-            kp = pressure_pair(p_i, rho_i, equation_of_state(rho_j, rho_eq, c2), rho_j, mass, f)
-            wx, wy, wz = viscous_pair(pair_viscosity(mu_i, viscosity[j]), mass * mass * f / (rho_i * rho_j),
+            vol_j = volume[j]
+            kp = pressure_pair(p_i, pressure[j], f)
+            wx, wy, wz = viscous_pair(pair_viscosity(mu_i, viscosity[j]), f * vol_i * vol_j,
                                       dx, dy, dz, r2, vx, vy, vz, alpha, beta)
             fx = kp * dx + wx
             fy = kp * dy + wy
@@ -81,7 +80,7 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscos
             syx += fy * dx
             if bulk_gradient:
                 t = f * (a_i - bulk_factor * viscosity[j])
-                tj = t * mass / rho_j
+                tj = t * vol_j
                 gxi += tj * dx
                 gyi += tj * dy
                 gzi += tj * dz
@@ -104,24 +103,28 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscos
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def force_sums(start, pair_end, pair_j, geometry, velocity, rho, viscosity, mass, rho_eq, c2,
-               alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc, scratch, bounds, virial):
-    """acc (6 N,) = pair forces and ∇a sums of every particle; virial (T, 5) per chunk."""
+def force_sums(start, pair_end, pair_j, geometry, velocity, rho, volume, viscosity, mass, rho_eq,
+               c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, pressure, acc, scratch,
+               bounds, virial):
+    """acc (6 N,) = pair forces and ∇a sums of every particle; virial (T, 5) per chunk;
+    ``pressure`` (N,) scratch for the particles' m² P/ρ²."""
+    for i in prange(rho.shape[0]):
+        pressure[i] = pressure_term(rho[i], rho_eq, c2, mass)
     n_chunks = scratch.shape[0] + 1
     chunk_bounds(start, n_chunks, bounds)
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:
             acc[:] = 0.0
-            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscosity,
-                        mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc,
+            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure,
+                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc,
                         virial[0])
         else:
             buffer = scratch[c - 1]
             buffer[FORCE_WIDTH * lo:] = 0.0
-            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, viscosity,
-                        mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
-                        buffer, virial[c])
+            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure,
+                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, buffer,
+                        virial[c])
     add_chunk_buffers(acc, scratch, bounds, n_chunks, FORCE_WIDTH)
 
 

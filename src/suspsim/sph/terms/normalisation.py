@@ -5,9 +5,10 @@ The discrete viscous sum under-represents the continuum operator because the dis
 a linear velocity field v_ij = L r_ij (L_lk = ∂_k v_l, the local corrected gradient) the
 dissipation of particle i's viscous pair forces, per unit viscosity, is
 
-    D_i = Σ_j V_j F [α (r·L r)²/r² + β |L r|²],
+    D_i = Σ_j V_j F [α (r·L r)²/r² + β |L r|²] = α Σ_j V_j F (r·S r)²/r² + β (L Lᵀ) : M2,
 
-whose continuum value (∫F r_k r_l r_m r_n / r² = (δδ + δδ + δδ)/(d + 2), ∫F r r = I) is
+(the β part needs no pair loop: M2 = Σ_j V_j F r r is known from the gradient pass, and in 2D
+with the bulk correction α = 0, so the pass is skipped), whose continuum value (∫F r_k r_l r_m r_n / r² = (δδ + δδ + δδ)/(d + 2), ∫F r r = I) is
 
     D_c = α ((tr L)² + 2 S:S)/(d + 2) + β L:L,    S = (L + Lᵀ)/2.
 
@@ -37,12 +38,52 @@ DEGENERATE = 1e-12
 
 @njit(inline="always", **JIT_OPTIONS)
 def pair_dissipation(g, dx, dy, dz, r2, alpha, beta):
-    """α (r·L r)²/r² + β |L r|² with (L r)_l = Σ_k r_k g[3k + l] (module docstring)."""
+    """α (r·L r)²/r² + β |L r|² with (L r)_l = Σ_k r_k g[3k + l] (module docstring).
+
+    The reference form of one pair's term; the pass uses the split below, which is the same
+    sum in another order.
+    """
     ux = dx * g[0] + dy * g[3] + dz * g[6]
     uy = dx * g[1] + dy * g[4] + dz * g[7]
     uz = dx * g[2] + dy * g[5] + dz * g[8]
     ru = dx * ux + dy * uy + dz * uz
     return alpha * ru * ru / r2 + beta * (ux * ux + uy * uy + uz * uz)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def strain_form(g, out):
+    """out = (S_xx, S_yy, S_zz, 2 S_xy, 2 S_xz, 2 S_yz), S = (L + Lᵀ)/2, so that
+    r·L r = r·S r = Σ out · (x², y², z², xy, xz, yz)."""
+    out[0] = g[0]
+    out[1] = g[4]
+    out[2] = g[8]
+    out[3] = g[1] + g[3]
+    out[4] = g[2] + g[6]
+    out[5] = g[5] + g[7]
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def quadratic_form(s, xx, yy, zz, xy, xz, yz):
+    """r·S r from :func:`strain_form`'s ``s`` and the monomials of r."""
+    return s[0] * xx + s[1] * yy + s[2] * zz + s[3] * xy + s[4] * xz + s[5] * yz
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def moment_dissipation(g, moment):
+    """Σ_j V_j F |L r_ij|² = (L Lᵀ) : M2, the β part of D_i without a pair loop.
+
+    |L r|² = Σ_km r_k r_m C_km with C_km = Σ_l g[3k + l] g[3m + l]; ``moment`` is M2 =
+    Σ_j V_j F r r stored as (xx, yy, zz, xy, xz, yz).
+    """
+    c = 0.0
+    for k in range(3):
+        for m in range(3):
+            ckm = g[3 * k] * g[3 * m] + g[3 * k + 1] * g[3 * m + 1] + g[3 * k + 2] * g[3 * m + 2]
+            if k == m:
+                c += ckm * moment[k]
+            else:
+                c += ckm * moment[2 + k + m]
+    return c
 
 
 @njit(inline="always", **JIT_OPTIONS)

@@ -27,10 +27,17 @@ def equation_of_state(rho, rho_eq, c2):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def pressure_pair(p_i, rho_i, p_j, rho_j, mass, f):
-    """Scalar k with force f_ij = k r_ij on i from j: k = m² (P_i/ρ_i² + P_j/ρ_j²) F(r_ij).
+def pressure_term(rho, rho_eq, c2, mass):
+    """m² P/ρ², one particle's share of the pressure pair force (:func:`pressure_pair`)."""
+    return mass * mass * equation_of_state(rho, rho_eq, c2) / (rho * rho)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def pressure_pair(term_i, term_j, f):
+    """Scalar k with force f_ij = k r_ij on i from j: k = m² (P_i/ρ_i² + P_j/ρ_j²) F(r_ij),
+    from the particles' :func:`pressure_term`.
 
     Seed 000 Eq. 18 (times m): dv_i/dt = m Σ_j (P_i/ρ_i² + P_j/ρ_j²) F r_ij; antisymmetric in
     (i, j) because r_ji = −r_ij.
     """
-    return mass * mass * (p_i / (rho_i * rho_i) + p_j / (rho_j * rho_j)) * f
+    return (term_i + term_j) * f

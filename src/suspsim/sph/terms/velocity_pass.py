@@ -8,10 +8,12 @@ SPEC §2.6); a pair across a sheared face has v_ij,x −= n γ̇ L_y (SPEC §2.7
 
 Pass 1 (:func:`gradient_pass`): per particle G (9) and M2 (6) (``gradient``), then per particle
 g = M2⁻¹ G, γ̇ and, for a non-Newtonian law, μ = viscosity_kernel(code, params, γ̇).
-Pass 2 (:func:`normalisation_pass`): D_i = Σ_j V_j F q(g_i, r_ij) (``normalisation``), then
-s_i and μ̂_i = μ_i/s_i. Without the normalisation μ̂ = μ and pass 2 is skipped.
+Pass 2 (:func:`normalisation_pass`): D_i = α Σ_j V_j F (r·S_i r)²/r² + β (L Lᵀ):M2
+(``normalisation``; the β part is per particle, from pass 1), then s_i and μ̂_i = μ_i/s_i.
+Without the normalisation μ̂ = μ and pass 2 is skipped; with α = 0 (2D with the bulk
+correction) only its per-particle half runs.
 
-Symbols: V_j = m/ρ_j particle volume [h^d]; ``shear_ly`` γ̇ L_y, the velocity jump across the
+Symbols: V_j = m/ρ_j particle volume [h^d] (``volume``, computed once per step); ``shear_ly`` γ̇ L_y, the velocity jump across the
 sheared faces [h τ^−1]; the other symbols as in ``gradient`` and ``normalisation``.
 """
 from __future__ import annotations
@@ -22,19 +24,18 @@ from suspsim.rheology.laws import viscosity_kernel
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
 from suspsim.sph.terms.gradient import XX, YY, ZZ, corrected_gradient, invert_symmetric, shear_rate
-from suspsim.sph.terms.normalisation import (continuum_dissipation, normalisation_factor,
-                                             pair_dissipation)
+from suspsim.sph.terms.normalisation import (continuum_dissipation, moment_dissipation,
+                                             normalisation_factor, quadratic_form, strain_form)
 
 #: Values per particle accumulated by the gradient pass: G (9) then M2 (xx, yy, zz, xy, xz, yz).
 GRADIENT_WIDTH = 15
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly,
-                   acc):
+def _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly, acc):
     """acc[15 i ...] += (G, M2) of particles lo..hi−1, both ends of each pair."""
     for i in range(lo, hi):
-        vol_i = mass / rho[i]
+        vol_i = volume[i]
         vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
         g0 = g1 = g2 = g3 = g4 = g5 = g6 = g7 = g8 = 0.0
         mxx = myy = mzz = mxy = mxz = myz = 0.0
@@ -46,7 +47,7 @@ def _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mas
             vy = vyi - velocity[j, 1]
             vz = vzi - velocity[j, 2]
             fi = f * vol_i
-            fj = f * mass / rho[j]
+            fj = f * volume[j]
             a0, a1, a2 = dx * vx, dx * vy, dx * vz
             a3, a4, a5 = dy * vx, dy * vy, dy * vz
             a6, a7, a8 = dz * vx, dz * vy, dz * vz
@@ -102,8 +103,8 @@ def _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mas
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _gradient_sums(start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly, acc,
-                   scratch, bounds):
+def _gradient_sums(start, pair_end, pair_j, geometry, velocity, volume, shear_ly, acc, scratch,
+                   bounds):
     """acc (15 N,) = (G, M2) of every particle, T = scratch.shape[0] + 1 chunks."""
     n_chunks = scratch.shape[0] + 1
     chunk_bounds(start, n_chunks, bounds)
@@ -111,20 +112,22 @@ def _gradient_sums(start, pair_end, pair_j, geometry, velocity, rho, mass, shear
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:
             acc[:] = 0.0
-            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mass,
-                           shear_ly, acc)
+            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
+                           acc)
         else:
             buffer = scratch[c - 1]
             buffer[GRADIENT_WIDTH * lo:] = 0.0
-            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, rho, mass,
-                           shear_ly, buffer)
+            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
+                           buffer)
     add_chunk_buffers(acc, scratch, bounds, n_chunks, GRADIENT_WIDTH)
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _gradient_finish(acc, dimension, law_code, law_params, newtonian, gradient, inverse_moment,
-                     moment_trace, gdot, viscosity):
-    """Per particle: g = M2⁻¹ G, tr M2, γ̇ and (non-Newtonian) μ(γ̇) [SPEC §2.5, §1.1]."""
+def _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise, beta, gradient,
+                     inverse_moment, moment_trace, gdot, viscosity, strain, dissipation):
+    """Per particle: g = M2⁻¹ G, tr M2, γ̇ and (non-Newtonian) μ(γ̇) [SPEC §2.5, §1.1]; with
+    ``normalise`` also the strain form of g and the β part β (L Lᵀ):M2 of D_i
+    (``normalisation``)."""
     for i in prange(gradient.shape[0]):
         sums = acc[GRADIENT_WIDTH * i:GRADIENT_WIDTH * (i + 1)]
         moment = sums[9:]
@@ -139,76 +142,86 @@ def _gradient_finish(acc, dimension, law_code, law_params, newtonian, gradient, 
         gdot[i] = rate
         if not newtonian:
             viscosity[i] = viscosity_kernel(law_code, law_params, rate)
+        if normalise:
+            strain_form(g, strain[i])
+            if dimension == 2:
+                moment[ZZ] = 0.0
+            dissipation[i] = beta * moment_dissipation(g, moment)
 
 
-def gradient_pass(start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly, dimension,
-                  law_code, law_params, newtonian, acc, scratch, bounds, gradient,
-                  inverse_moment, moment_trace, gdot, viscosity):
+def gradient_pass(start, pair_end, pair_j, geometry, velocity, volume, shear_ly, dimension,
+                  law_code, law_params, newtonian, normalise, beta, acc, scratch, bounds,
+                  gradient, inverse_moment, moment_trace, gdot, viscosity, strain, dissipation):
     """Python entry of pass 1 (the integrator calls the two compiled halves directly)."""
-    _gradient_sums(start, pair_end, pair_j, geometry, velocity, rho, mass, shear_ly, acc,
-                   scratch, bounds)
-    _gradient_finish(acc, dimension, law_code, law_params, newtonian, gradient, inverse_moment,
-                     moment_trace, gdot, viscosity)
+    _gradient_sums(start, pair_end, pair_j, geometry, velocity, volume, shear_ly, acc, scratch,
+                   bounds)
+    _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise, beta, gradient,
+                     inverse_moment, moment_trace, gdot, viscosity, strain, dissipation)
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, rho, mass, gradient, alpha,
-                      beta, acc):
-    """acc[i] += Σ_j V_j F q(g_i, r_ij) for particles lo..hi−1, both ends of each pair."""
+def _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, volume, strain, acc):
+    """acc[i] += Σ_j V_j F (r·S_i r)²/r² for particles lo..hi−1, both ends of each pair."""
     for i in range(lo, hi):
-        vol_i = mass / rho[i]
-        gi = gradient[i]
+        vol_i = volume[i]
+        si = strain[i]
         own = 0.0
         for k in range(start[i], pair_end[i]):
             j = pair_j[k]
             row = geometry[k]
             dx, dy, dz, f = row[0], row[1], row[2], row[3]
-            r2 = dx * dx + dy * dy + dz * dz
-            own += f * mass / rho[j] * pair_dissipation(gi, dx, dy, dz, r2, alpha, beta)
-            acc[j] += f * vol_i * pair_dissipation(gradient[j], dx, dy, dz, r2, alpha, beta)
+            xx, yy, zz = dx * dx, dy * dy, dz * dz
+            xy, xz, yz = dx * dy, dx * dz, dy * dz
+            w = f / (xx + yy + zz)
+            qi = quadratic_form(si, xx, yy, zz, xy, xz, yz)
+            qj = quadratic_form(strain[j], xx, yy, zz, xy, xz, yz)
+            own += w * volume[j] * qi * qi
+            acc[j] += w * vol_i * qj * qj
         acc[i] += own
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _dissipation_sums(start, pair_end, pair_j, geometry, rho, mass, gradient, alpha, beta, acc,
-                      scratch, bounds):
-    """acc (N,) = discrete dissipation D_i of every particle's local linear field."""
+def _dissipation_sums(start, pair_end, pair_j, geometry, volume, strain, acc, scratch, bounds):
+    """acc (N,) = Σ_j V_j F (r·S_i r)²/r², the α part of D_i without α (``normalisation``)."""
     n_chunks = scratch.shape[0] + 1
     chunk_bounds(start, n_chunks, bounds)
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:
             acc[:] = 0.0
-            _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, rho, mass, gradient,
-                              alpha, beta, acc)
+            _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, volume, strain, acc)
         else:
             buffer = scratch[c - 1]
             buffer[lo:] = 0.0
-            _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, rho, mass, gradient,
-                              alpha, beta, buffer)
+            _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, volume, strain, buffer)
     add_chunk_buffers(acc, scratch, bounds, n_chunks, 1)
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _normalisation_finish(acc, gradient, moment_trace, viscosity, alpha, beta, dimension, factor,
-                          viscosity_hat):
-    """s_i = D_i/D_c (``normalisation``) and μ̂_i = μ_i/s_i."""
+def _normalisation_finish(acc, dissipation, gradient, moment_trace, viscosity, alpha, beta,
+                          dimension, factor, viscosity_hat):
+    """D_i = α acc_i + β (L Lᵀ):M2 (``dissipation``), s_i = D_i/D_c and μ̂_i = μ_i/s_i."""
     for i in prange(viscosity.shape[0]):
         g = gradient[i]
         norm2 = 0.0
         for k in range(9):
             norm2 += g[k] * g[k]
-        s = normalisation_factor(acc[i], continuum_dissipation(g, alpha, beta, dimension), norm2,
+        s = normalisation_factor(alpha * acc[i] + dissipation[i],
+                                 continuum_dissipation(g, alpha, beta, dimension), norm2,
                                  moment_trace[i], dimension)
         factor[i] = s
         viscosity_hat[i] = viscosity[i] / s
 
 
-def normalisation_pass(start, pair_end, pair_j, geometry, rho, mass, gradient, moment_trace,
-                       viscosity, alpha, beta, dimension, acc, scratch, bounds, factor,
-                       viscosity_hat):
-    """Python entry of pass 2 (the integrator calls the two compiled halves directly)."""
-    _dissipation_sums(start, pair_end, pair_j, geometry, rho, mass, gradient, alpha, beta, acc,
-                      scratch, bounds)
-    _normalisation_finish(acc, gradient, moment_trace, viscosity, alpha, beta, dimension, factor,
-                          viscosity_hat)
+def normalisation_pass(start, pair_end, pair_j, geometry, volume, strain, gradient, moment_trace,
+                       viscosity, alpha, beta, dimension, acc, scratch, bounds, dissipation,
+                       factor, viscosity_hat):
+    """Python entry of pass 2 (the integrator calls the compiled halves directly); the pair
+    sums run only when α ≠ 0."""
+    if alpha != 0.0:
+        _dissipation_sums(start, pair_end, pair_j, geometry, volume, strain, acc, scratch,
+                          bounds)
+    else:
+        acc[:] = 0.0
+    _normalisation_finish(acc, dissipation, gradient, moment_trace, viscosity, alpha, beta,
+                          dimension, factor, viscosity_hat)
