@@ -290,3 +290,14 @@ def test_plot_fit_draws_two_log_log_panels():
     ax = own.subplots()
     assert plot_fit(rate, stress, result, ax=ax, label="mine") is own and len(own.axes) == 1
     assert ax.get_legend().get_texts()[0].get_text() == "mine"
+
+
+def test_points_at_one_rate_that_disagree_are_flagged_not_dropped():
+    rate = np.geomspace(0.1, 100.0, 12)
+    stress = 2.0 * rate
+    clean = fit_flow_curve(np.r_[rate, rate[3]], np.r_[stress, 1.3 * stress[3]], "newtonian")
+    assert not [note for note in clean.notes if "copied" in note]
+    bad = fit_flow_curve(np.r_[rate, rate[3]], np.r_[stress, 3.0 * stress[3]], "newtonian")
+    flagged = [note for note in bad.notes if "copied" in note]
+    assert len(flagged) == 1 and f"{rate[3]:.4g} 1/s" in flagged[0]
+    assert bad.n_points == 13

@@ -122,6 +122,8 @@ def test_ec_04_artifact_is_the_only_gross_outlier():
     worst = np.argmax(np.abs(residual))
     assert rate[worst] == 1000.0 and stress[worst] == pytest.approx(72.8)
     assert abs(residual[worst]) > 0.3 and np.sort(np.abs(residual))[-2] < 0.15
+    flagged = [note for note in raw.notes if "copied" in note]
+    assert len(flagged) == 1 and "shear rate 1000 1/s" in flagged[0]
 
 
 def test_ec_07_zero_shear_viscosity():

@@ -60,6 +60,11 @@ PREFER_SIMPLER_WITHIN = 2.0
 M_MAX_REL_STDERR = 0.5
 #: Largest M γ̇_min for which the lowest measured rate counts as on the low-rate plateau.
 M_PLATEAU_MAX = 0.5
+#: Stress ratio beyond which points at one shear rate are flagged (:func:`repeated_rate_notes`)
+#: [choice: repeated measurements at one rate differ by tens of per cent at most (thixotropy, edge
+#: fracture); of the 55 shared and shipped files only ec_shear_viscosity_04-00 has a pair
+#: beyond 2× — 2.7×, its last row copied from 03-00].
+REPEAT_DISAGREEMENT = 2.0
 
 
 @dataclass(frozen=True)
@@ -237,10 +242,37 @@ def fit_flow_curve(shear_rate, shear_stress, law: str = "auto", *,
     if criterion not in CRITERIA:
         raise ValueError(f"unknown criterion {criterion!r}; choose one of {', '.join(CRITERIA)}")
     data = validate_data(shear_rate, shear_stress)
+    if law != "auto" and law not in LAW_SPECS:
+        raise ValueError(f"unknown law {law!r}; known laws: auto, {', '.join(LAW_SPECS)}")
+    suspicious = repeated_rate_notes(data)
+    for note in suspicious:
+        logger.warning("%s: %s", source or "flow curve", note)
     if law == "auto":
         from suspsim.rheology.selection import select_law
-        return select_law(data, candidates, criterion=criterion, source=source,
-                          n_starts=n_starts, seed=seed)
-    if law not in LAW_SPECS:
-        raise ValueError(f"unknown law {law!r}; known laws: auto, {', '.join(LAW_SPECS)}")
-    return fit_law(law, data, criterion=criterion, source=source, n_starts=n_starts, seed=seed)
+        result = select_law(data, candidates, criterion=criterion, source=source,
+                            n_starts=n_starts, seed=seed)
+    else:
+        result = fit_law(law, data, criterion=criterion, source=source, n_starts=n_starts,
+                         seed=seed)
+    return replace(result, notes=result.notes + suspicious) if suspicious else result
+
+
+def repeated_rate_notes(data: FlowData) -> tuple[str, ...]:
+    """Notes on points measured at the same shear rate whose stresses differ by more than
+    :data:`REPEAT_DISAGREEMENT` ×: up and down sweeps agree far better, so such a pair is more
+    likely a row copied from another file or sample than a measurement (it is kept in the fit;
+    the note lets the user decide)."""
+    notes = []
+    order = np.argsort(data.rate, kind="stable")
+    rate, stress = data.rate[order], data.stress[order]
+    start = 0
+    for k in range(1, rate.size + 1):
+        if k < rate.size and rate[k] == rate[start]:
+            continue
+        group = stress[start:k]
+        if group.size > 1 and group.max() > REPEAT_DISAGREEMENT * group.min():
+            notes.append(f"{group.size} points at shear rate {rate[start]:.4g} 1/s have stresses "
+                         f"{group.min():.4g} to {group.max():.4g} Pa (more than "
+                         f"{REPEAT_DISAGREEMENT:g}x apart): a row copied from another file?")
+        start = k
+    return tuple(notes)
