@@ -66,7 +66,9 @@ _BENCH_COLUMNS = (("scene", "scene", "{}"), ("particles", "n_particles", "{}"),
                   ("particle-steps/s", "particle_steps_per_s", "{:.3g}"),
                   ("rebuilds", "rebuilds", "{}"),
                   ("viscosity error", "viscosity_error", "{:+.2%}"),
-                  ("density error", "density_error", "{:.2%}"))
+                  ("density error", "density_error", "{:.2%}"),
+                  ("rebuild share", "rebuild_share", "{:.1%}"),
+                  ("bytes/particle", "bytes_per_particle", "{:.0f}"))
 
 
 def _positive_int(text: str) -> int:
@@ -125,6 +127,10 @@ def _cmd_bench(args) -> int:
         widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
         for row in rows:
             print("  ".join(cell.rjust(width) for cell, width in zip(row, widths)))
+        for r in results:
+            if "pass_ms" in r:
+                print(f"{r['scene']} pass times [ms]: "
+                      + ", ".join(f"{k} {v:.2f}" for k, v in r["pass_ms"].items()))
     return 0
 
 

@@ -120,3 +120,9 @@ def test_bench_json_lines(tmp_path):
     rows = [json.loads(line) for line in proc.stdout.strip().splitlines()]
     assert len(rows) == 1 and rows[0]["scene"] == "fluid-newtonian" and rows[0]["threads"] == 1
     assert rows[0]["n_particles"] > 0 and rows[0]["particle_steps_per_s"] > 0
+    # The error reached, and where the time and memory go.
+    assert abs(rows[0]["viscosity_error"]) < 0.2 and rows[0]["density_error"] < 0.05
+    assert 0.0 <= rows[0]["rebuild_share"] < 1.0 and rows[0]["bytes_per_particle"] > 100
+    assert set(rows[0]["pass_ms"]) == {"density", "gradient sums", "gradient finish",
+                                       "dissipation sums", "normalisation finish", "force sums",
+                                       "force finish"}

@@ -19,7 +19,11 @@ import numba
 import numpy as np
 
 from suspsim.scene import scene_from_dict
-from suspsim.sph.simulation import Simulation
+from suspsim.sph.density import mass_density, summation_density
+from suspsim.sph.simulation import SUPPORT, Simulation
+from suspsim.sph.terms.force_pass import force_finish, force_sums
+from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
+                                             _normalisation_finish)
 
 #: Untimed steps before timing: compilation, and the first relaxation of the jittered lattice
 #: (density error ≈ 14 % at step 5, ≈ 1 % from step ~50 on).
@@ -51,7 +55,8 @@ def benchmark(scene_name: str, n_steps: int, threads: int) -> dict:
     """Time ``n_steps`` full steps of ``scene_name`` on ``threads`` threads.
 
     Returns {scene, n_particles, threads, steps, wall_time_s, particle_steps_per_s, rebuilds,
-    dt, sound_speed, viscosity_error, density_error}. The error reached: viscosity_error is
+    dt, sound_speed, viscosity_error, density_error, rebuild_share (of the timed wall time),
+    bytes_per_particle (``Simulation.memory_bytes``), pass_ms (:func:`pass_times`)}. The error reached: viscosity_error is
     ⟨σ_xy⟩/(μ(γ̇) γ̇) − 1 over 20 samples spread across the timed steps (the run starts from
     the linear profile, and a sheared lattice makes the stress oscillate by ±7 % with period
     one strain unit, so this is the solver's error over the window — 500 steps are one strain
@@ -62,7 +67,7 @@ def benchmark(scene_name: str, n_steps: int, threads: int) -> dict:
     scene = benchmark_scene(scene_name)
     sim = Simulation(scene, threads=threads)
     sim.advance(WARM_UP)
-    builds = sim.rebuild_count
+    builds, rebuild_seconds = sim.rebuild_count, sim.rebuild_seconds
     samples = min(SAMPLES, n_steps)
     wall, stresses, density_error = 0.0, [], 0.0
     for k in range(samples):
@@ -75,9 +80,66 @@ def benchmark(scene_name: str, n_steps: int, threads: int) -> dict:
         density_error = max(density_error, sample["density_error"])
     rate = scene.flow.shear_rate
     viscosity = float(scene.fluid.law.viscosity(rate))
+    passes = pass_times(sim)
     return {"scene": scene_name, "n_particles": sim.n_particles, "threads": threads,
             "steps": int(n_steps), "wall_time_s": wall,
             "particle_steps_per_s": sim.n_particles * n_steps / wall,
             "rebuilds": sim.rebuild_count - builds, "dt": sim.dt, "sound_speed": sim.sound_speed,
             "viscosity_error": float(np.mean(stresses)) / (viscosity * rate) - 1.0,
-            "density_error": density_error}
+            "density_error": density_error,
+            "rebuild_share": (sim.rebuild_seconds - rebuild_seconds) / wall,
+            "bytes_per_particle": sim.memory_bytes() / sim.n_particles,
+            "pass_ms": {name: 1e3 * seconds for name, seconds in passes.items()}}
+
+
+def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
+    """Best-of-``repeats`` wall time [s] of each compiled pass of one step on ``sim``'s state.
+
+    The passes run in step order on the current positions and velocities (the state is
+    recomputed, not advanced): density (with the pair table), gradient sums and finish,
+    dissipation sums and normalisation finish (when the scene normalises), force sums and
+    finish. Their sum is the step without drift, kick and rebuilds.
+    """
+    numba.set_num_threads(sim.threads)
+    box, tb, nl = sim._box, sim._table, sim._nlist
+    law = sim.scene.fluid.law
+    shear_ly = sim._rate * box[1]
+    calls = {"density": lambda: (
+        summation_density(sim._x, box, sim._offset(sim.time), nl.start, nl.image_start,
+                          nl.neighbours, sim._kernel, SUPPORT, sim._rho, tb.pair_end, tb.pair_j,
+                          tb.pair_geometry, sim._scratch_1, sim._bounds),
+        mass_density(sim._rho, sim._mass, sim._volume))}
+    if sim._velocity_gradient:
+        calls["gradient sums"] = lambda: _gradient_sums(
+            nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._v, sim._volume, shear_ly,
+            sim._grad_acc, sim._scratch_15, sim._bounds)
+        calls["gradient finish"] = lambda: _gradient_finish(
+            sim._grad_acc, sim.scene.dimension, law.code, law.packed, sim._newtonian,
+            sim._normalise, sim._beta, sim._gradient, sim._inverse_moment, sim._moment_trace,
+            sim._gdot, sim._mu, sim._strain, sim._dissipation)
+    if sim._normalise:
+        if sim._alpha != 0.0:
+            calls["dissipation sums"] = lambda: _dissipation_sums(
+                nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._volume, sim._strain,
+                sim._diss_acc, sim._scratch_1, sim._bounds)
+        calls["normalisation finish"] = lambda: _normalisation_finish(
+            sim._diss_acc, sim._dissipation, sim._gradient, sim._moment_trace, sim._mu,
+            sim._alpha, sim._beta, sim.scene.dimension, sim._factor, sim._mu_hat)
+    calls["force sums"] = lambda: force_sums(
+        nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._v, sim._rho, sim._volume,
+        sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2, sim._alpha, sim._beta,
+        sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._pressure, sim._force_acc,
+        sim._scratch_6, sim._bounds, sim._virial)
+    calls["force finish"] = lambda: force_finish(
+        sim._force_acc, sim._x, sim._rho, sim._inverse_moment, sim._gradient, sim._mass,
+        sim._bulk_gradient, sim._body_force, box[1], sim._a_new)
+    best = {}
+    for name, call in calls.items():
+        call()
+        times = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            call()
+            times.append(time.perf_counter() - start)
+        best[name] = min(times)
+    return best

@@ -16,7 +16,9 @@ thread count of the resumed run.
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
+import time as time_module
 
 import numba
 import numpy as np
@@ -91,6 +93,7 @@ class Simulation:
             self.step_count = int(_state["step_count"])
             self._build_time = float(_state["build_time"])
         self.rebuild_count = 0
+        self.rebuild_seconds = 0.0
         self._allocate(positions, velocities, capacity_factor=1.5)
         if _state is None:
             self._rebuild(0.0)
@@ -146,6 +149,7 @@ class Simulation:
 
     def _rebuild(self, time: float) -> None:
         """Wrap, sort and list at ``time``; grows the list once per overflow."""
+        started = time_module.perf_counter()
         while True:
             try:
                 rebuild_neighbour_list(self._nlist, self._x, self._v, self._box,
@@ -158,6 +162,7 @@ class Simulation:
                 self._allocate_list(factor)
         self._build_time = time
         self.rebuild_count += 1
+        self.rebuild_seconds += time_module.perf_counter() - started
 
     def _relist_from_reference(self) -> None:
         """Rebuild the list of the last build from its (sorted) positions, without reordering."""
@@ -217,6 +222,14 @@ class Simulation:
             if rebuild:
                 self._rebuild((self.step_count + 1) * self.dt)
                 nl = self._nlist
+
+    def memory_bytes(self) -> int:
+        """Bytes held by the particle arrays, the neighbour list, the pair table and scratch."""
+        held = [value for value in vars(self).values() if isinstance(value, np.ndarray)]
+        for group in (self._nlist, self._table):
+            held += [getattr(group, f.name) for f in dataclasses.fields(group)
+                     if isinstance(getattr(group, f.name), np.ndarray)]
+        return sum({id(a): a.nbytes for a in held}.values())
 
     def _peculiar(self) -> np.ndarray:
         """Velocities relative to the imposed flow (positions unwrapped since the last build)."""
