@@ -112,7 +112,7 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     if sim._velocity_gradient:
         calls["gradient sums"] = lambda: _gradient_sums(
             nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._v, sim._volume, shear_ly,
-            sim._grad_acc, sim._scratch_15, sim._bounds)
+            sim.scene.dimension, sim._grad_acc, sim._scratch_15, sim._bounds)
         calls["gradient finish"] = lambda: _gradient_finish(
             sim._grad_acc, sim.scene.dimension, law.code, law.packed, sim._newtonian,
             sim._normalise, sim._beta, sim._gradient, sim._inverse_moment, sim._moment_trace,

@@ -80,7 +80,7 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     mass_density(rho, mass, volume)
     if velocity_gradient:
         _gradient_sums(nl_start, pair_end, pair_j, geometry, predicted, volume, shear_ly,
-                       grad_acc, scratch_15, bounds)
+                       dimension, grad_acc, scratch_15, bounds)
         _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian, normalise, beta,
                          gradient, inverse_moment, moment_trace, gdot, viscosity, strain,
                          dissipation)

@@ -102,9 +102,65 @@ def _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, 
         acc[b + 14] += myz
 
 
+@njit(inline="always", **JIT_OPTIONS)
+def _gradient_loop_2d(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
+                      acc):
+    """:func:`_gradient_loop` for z ≡ 0: only G_xx, G_xy, G_yx, G_yy, M2_xx, M2_yy, M2_xy (the
+    other 8 of the 15 entries stay 0)."""
+    for i in range(lo, hi):
+        vol_i = volume[i]
+        vxi, vyi = velocity[i, 0], velocity[i, 1]
+        g0 = g1 = g3 = g4 = mxx = myy = mxy = 0.0
+        for k in range(start[i], pair_end[i]):
+            j = pair_j[k]
+            row = geometry[k]
+            dx, dy, f = row[0], row[1], row[3]
+            vx = vxi - velocity[j, 0] - row[4] * shear_ly
+            vy = vyi - velocity[j, 1]
+            fi = f * vol_i
+            fj = f * volume[j]
+            a0, a1, a3, a4 = dx * vx, dx * vy, dy * vx, dy * vy
+            bxx, byy, bxy = dx * dx, dy * dy, dx * dy
+            g0 += fj * a0
+            g1 += fj * a1
+            g3 += fj * a3
+            g4 += fj * a4
+            mxx += fj * bxx
+            myy += fj * byy
+            mxy += fj * bxy
+            b = 15 * j
+            acc[b] += fi * a0
+            acc[b + 1] += fi * a1
+            acc[b + 3] += fi * a3
+            acc[b + 4] += fi * a4
+            acc[b + 9] += fi * bxx
+            acc[b + 10] += fi * byy
+            acc[b + 12] += fi * bxy
+        b = 15 * i
+        acc[b] += g0
+        acc[b + 1] += g1
+        acc[b + 3] += g3
+        acc[b + 4] += g4
+        acc[b + 9] += mxx
+        acc[b + 10] += myy
+        acc[b + 12] += mxy
+
+
+@njit(**JIT_OPTIONS)
+def _gradient_chunk(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
+                    dimension, acc):
+    """The 2D or 3D loop (each compiled with its dimension fixed)."""
+    if dimension == 2:
+        _gradient_loop_2d(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
+                          acc)
+    else:
+        _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
+                       acc)
+
+
 @njit(parallel=True, **JIT_OPTIONS)
-def _gradient_sums(start, pair_end, pair_j, geometry, velocity, volume, shear_ly, acc, scratch,
-                   bounds):
+def _gradient_sums(start, pair_end, pair_j, geometry, velocity, volume, shear_ly, dimension, acc,
+                   scratch, bounds):
     """acc (15 N,) = (G, M2) of every particle, T = scratch.shape[0] + 1 chunks."""
     n_chunks = scratch.shape[0] + 1
     chunk_bounds(start, n_chunks, bounds)
@@ -112,13 +168,13 @@ def _gradient_sums(start, pair_end, pair_j, geometry, velocity, volume, shear_ly
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:
             acc[:] = 0.0
-            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
-                           acc)
+            _gradient_chunk(lo, hi, start, pair_end, pair_j, geometry, velocity, volume,
+                            shear_ly, dimension, acc)
         else:
             buffer = scratch[c - 1]
             buffer[GRADIENT_WIDTH * lo:] = 0.0
-            _gradient_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
-                           buffer)
+            _gradient_chunk(lo, hi, start, pair_end, pair_j, geometry, velocity, volume,
+                            shear_ly, dimension, buffer)
     add_chunk_buffers(acc, scratch, bounds, n_chunks, GRADIENT_WIDTH)
 
 
@@ -153,8 +209,8 @@ def gradient_pass(start, pair_end, pair_j, geometry, velocity, volume, shear_ly,
                   law_code, law_params, newtonian, normalise, beta, acc, scratch, bounds,
                   gradient, inverse_moment, moment_trace, gdot, viscosity, strain, dissipation):
     """Python entry of pass 1 (the integrator calls the two compiled halves directly)."""
-    _gradient_sums(start, pair_end, pair_j, geometry, velocity, volume, shear_ly, acc, scratch,
-                   bounds)
+    _gradient_sums(start, pair_end, pair_j, geometry, velocity, volume, shear_ly, dimension, acc,
+                   scratch, bounds)
     _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise, beta, gradient,
                      inverse_moment, moment_trace, gdot, viscosity, strain, dissipation)
 
