@@ -1,12 +1,15 @@
 """The ``suspsim`` command line: ``suspsim fit FILE [--law NAME|auto] [--sample ID] [--out F] [--plot F]``.
 
 Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N]`` (an SPH run, see
-:mod:`suspsim.run`) and ``suspsim bench [--scene NAME] [--threads N] [--steps K] [--json]``.
+:mod:`suspsim.run`), ``suspsim bench [--scene NAME] [--threads N] [--steps K] [--json]`` and
+``suspsim pack --shape sphere|sand --phi PHI --radius A --box LX LY LZ --out PACK.nc
+[--polydispersity S] [--seed N] ...`` (a random packing, see :mod:`suspsim.bodies.packing`).
 
 Exit codes: 0 success; 1 user or input error (one line on stderr naming the file, the place
-in it and the problem; no output written); 2 numerical failure (the last good checkpoint is
-kept); 128 + signal for a run stopped by a signal after saving its checkpoint (130 SIGINT,
-143 SIGTERM; ``--resume`` continues it).
+in it and the problem, or the bad command-line option; no output written); 2 numerical
+failure (the last good checkpoint is kept; a packing that cannot be reached writes nothing);
+128 + signal for a run stopped by a signal after saving its checkpoint (130 SIGINT, 143 SIGTERM;
+``--resume`` continues it).
 """
 from __future__ import annotations
 
@@ -22,11 +25,19 @@ from .errors import InputError, NumericalError, SuspsimError
 log = logging.getLogger("suspsim")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with the exit code of a user error (1, not argparse's 2, which means a
+    numerical failure here) and a one-line message instead of usage + message."""
+
+    def error(self, message: str):
+        self.exit(1, f"{self.prog}: error: {message}\n")
+
+
 def _build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="suspsim", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="suspsim", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"suspsim {__version__}")
     parser.add_argument("-q", "--quiet", action="store_true", help="log warnings and errors only")
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     fit = sub.add_parser("fit", help="fit a constitutive law to a rheometer flow curve")
     fit.add_argument("file", help="rheometer export (CSV/TXT in any common layout, TRIOS .xls/.xlsx, "
@@ -55,6 +66,31 @@ def _build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--steps", type=_positive_int, default=200, help="time steps to time "
                        "(default: 200)")
     bench.add_argument("--json", action="store_true", help="print one JSON object per scene")
+
+    pack = sub.add_parser("pack", help="pack random non-overlapping spheres or sand grains in a "
+                          "periodic box and write them as netCDF")
+    pack.add_argument("--shape", required=True, choices=("sphere", "sand"), help="body shape")
+    pack.add_argument("--phi", required=True, type=float, help="volume fraction, exact "
+                      "(tested up to 0.55 for spheres, 0.50 for sand)")
+    pack.add_argument("--radius", required=True, type=float, help="mean (volume-equivalent) "
+                      "radius [h]")
+    pack.add_argument("--box", required=True, type=float, nargs=3, metavar=("LX", "LY", "LZ"),
+                      help="box lengths [h]")
+    pack.add_argument("--out", required=True, help="output netCDF file")
+    pack.add_argument("--polydispersity", type=float, default=0.0, help="coefficient of "
+                      "variation of the radii, truncated lognormal (default: 0)")
+    pack.add_argument("--size-ratio", type=float, default=5.0, help="largest/smallest radius "
+                      "bound, at most 5 (default: 5)")
+    pack.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    pack.add_argument("--min-gap", type=float, help="smallest gap between bodies [h] "
+                      "(default: 1e-3 x radius)")
+    pack.add_argument("--max-steps", type=int, help="relaxation step budget "
+                      "(default: 200000 for spheres, 20000 for sand)")
+    pack.add_argument("--degree", type=int, help="sand: spherical-harmonic degree (default: 20)")
+    pack.add_argument("--roughness", type=float, help="sand: rms radius deviation of degrees "
+                      ">= 3, relative (default: 0.02)")
+    pack.add_argument("--elongation", type=float, nargs=2, metavar=("LOW", "HIGH"),
+                      help="sand: range of the elongation L/W (default: 1.2 1.6)")
     return parser
 
 
@@ -134,7 +170,46 @@ def _cmd_bench(args) -> int:
     return 0
 
 
-_COMMANDS = {"fit": _cmd_fit, "run": _cmd_run, "bench": _cmd_bench}
+#: Packing parameters (Python API names) and the options that set them.
+_PACK_OPTIONS = {"volume_fraction": "--phi", "radius": "--radius", "box": "--box",
+                 "shape": "--shape", "polydispersity": "--polydispersity",
+                 "size_ratio": "--size-ratio", "seed": "--seed", "min_gap": "--min-gap",
+                 "max_steps": "--max-steps", "degree": "--degree", "roughness": "--roughness",
+                 "elongation_range": "--elongation"}
+_SAND_ONLY = ("degree", "roughness", "elongation_range")
+
+
+def _cmd_pack(args) -> int:
+    from .bodies.packing import pack
+    from .io.packing_file import write_packing
+
+    options = {"polydispersity": args.polydispersity, "size_ratio": args.size_ratio,
+               "seed": args.seed, "min_gap": args.min_gap, "max_steps": args.max_steps,
+               "degree": args.degree, "roughness": args.roughness,
+               "elongation_range": args.elongation}
+    options = {name: value for name, value in options.items() if value is not None}
+    if args.shape == "sphere":
+        for name in _SAND_ONLY:
+            if name in options:
+                raise InputError(_PACK_OPTIONS[name], "applies to --shape sand only")
+    if args.elongation is not None:
+        options["elongation_range"] = tuple(args.elongation)
+    try:
+        packing = pack(args.shape, args.box, args.phi, args.radius, **options)
+    except InputError as err:
+        raise InputError(_PACK_OPTIONS.get(err.source, err.source), err.problem) from None
+    write_packing(args.out, packing)
+    details = packing.details
+    print(f"packed {packing.count} {args.shape} bodies in a "
+          f"{' x '.join(f'{length:g}' for length in packing.box)} box: volume fraction "
+          f"{packing.volume_fraction:.12g} (asked {args.phi:g}), smallest gap "
+          f"{details['smallest_gap']:.3g} (min {packing.min_gap:.3g}), "
+          f"{details['relaxation_steps']} relaxation steps, {details['wall_time_s']:.2f} s; "
+          f"wrote {args.out}")
+    return 0
+
+
+_COMMANDS = {"fit": _cmd_fit, "run": _cmd_run, "bench": _cmd_bench, "pack": _cmd_pack}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -7,7 +7,8 @@ Garboczi 2002),
 
 in the orthonormal real basis (∫ Y_nm Y_n'm' dΩ = δ_nn' δ_mm'; no Condon–Shortley phase)
 
-    Y_n0 = P̄_n^0(cos θ),  Y_nm = √2 P̄_n^m(cos θ) cos mφ,  Y_n,−m = √2 P̄_n^m(cos θ) sin mφ  (m > 0),
+    Y_n0 = P̄_n^0(cos θ),  Y_nm = √2 P̄_n^m(cos θ) cos mφ,  Y_n,−m = √2 P̄_n^m(cos θ) sin mφ
+    (m > 0),
 
 with P̄_n^m the associated Legendre functions normalised so that 2π ∫_{−1}^{1} (P̄_n^m)² dx = 1,
 computed by the standard stable recurrence (Holmes & Featherstone, J. Geodesy 76, 279 (2002)):
@@ -35,7 +36,7 @@ from numba import njit
 
 __all__ = ["GaussGrid", "coefficient_count", "coefficient_degree", "coefficient_index",
            "degree_of", "evaluate", "evaluate_one", "gauss_grid", "legendre", "project",
-           "rotate_coefficients", "synthesize"]
+           "recurrence_tables", "rotate_coefficients", "synthesize"]
 
 
 def coefficient_count(degree: int) -> int:
@@ -65,7 +66,7 @@ def coefficient_degree(degree: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def legendre(degree: int, x: np.ndarray) -> np.ndarray:
-    """P̄_n^m(x) for 0 ≤ m ≤ n ≤ N as an array (N + 1, N + 1, len(x)) indexed [n, m]; 0 for m > n."""
+    """P̄_n^m(x) for 0 ≤ m ≤ n ≤ N, an array (N + 1, N + 1, len(x)) indexed [n, m]; 0 if m > n."""
     x = np.asarray(x, dtype=np.float64)
     s = np.sqrt(np.maximum(0.0, 1.0 - x * x))
     p = np.zeros((degree + 1, degree + 1) + x.shape)
@@ -148,54 +149,63 @@ def evaluate(coefficients: np.ndarray, directions: np.ndarray) -> np.ndarray:
     u = np.asarray(directions, dtype=np.float64)
     flat = u.reshape(-1, 3)
     out = np.empty(len(flat))
-    _evaluate_many(np.ascontiguousarray(coefficients, dtype=np.float64), flat, out)
+    alpha, beta = recurrence_tables(degree_of(coefficients))
+    _evaluate_many(np.ascontiguousarray(coefficients, dtype=np.float64), alpha, beta, flat, out)
     return out.reshape(u.shape[:-1])
 
 
-@njit(cache=True)
-def evaluate_one(a, degree, ux, uy, uz):
-    """r(u) = Σ a_nm Y_nm(u) at one unit vector, by the recurrences above (compiled, no allocation).
+def recurrence_tables(degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """α_nm and β_nm of the Legendre recurrence (module docstring), arrays (N + 1, N + 1)."""
+    n = np.arange(degree + 1, dtype=np.float64)[:, None]
+    m = np.arange(degree + 1, dtype=np.float64)[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        alpha = np.sqrt((4 * n * n - 1) / (n * n - m * m))
+        beta = np.sqrt(((n - 1) ** 2 - m * m) / (4 * (n - 1) ** 2 - 1))
+    valid = n >= m + 2
+    return np.where(valid, alpha, 0.0), np.where(valid, beta, 0.0)
 
-    cos mφ and sin mφ come from the complex power (u_x + i u_y)^m / sin^m θ, folded into the
-    sectoral recurrence: P̄_m^m sin^{−m}θ·(cos mφ, sin mφ)·sin^m θ = P̄_m^m (cos, sin) — so the
-    poles need no special case.
+
+@njit(cache=True)
+def evaluate_one(a, degree, alpha, beta, ux, uy, uz):
+    """r(u) = Σ a_nm Y_nm(u) at one unit vector (compiled, no allocation).
+
+    ``alpha``, ``beta`` from :func:`recurrence_tables`. With q_n^m = P̄_n^m / sin^m θ, which obeys
+    the same recurrence in x = u_z, and (c_m, s_m) = sin^m θ (cos mφ, sin mφ) = (Re, Im)
+    (u_x + i u_y)^m, every term is q_n^m (c_m, s_m): no angles, no special case at the poles.
     """
     x = uz
-    # (c_m, s_m) = sin^m θ (cos mφ, sin mφ) = Re, Im (u_x + i u_y)^m; P̄_n^m / sin^m θ recurs in x.
     c_m, s_m = 1.0, 0.0
-    q_mm = 1.0 / math.sqrt(4.0 * math.pi)  # P̄_m^m / sin^m θ
+    q_mm = 1.0 / math.sqrt(4.0 * math.pi)
+    root2 = math.sqrt(2.0)
     total = 0.0
     for m in range(degree + 1):
         if m > 0:
             q_mm *= math.sqrt((2 * m + 1) / (2 * m))
             c_m, s_m = c_m * ux - s_m * uy, c_m * uy + s_m * ux
-        wc = c_m if m == 0 else math.sqrt(2.0) * c_m
-        ws = math.sqrt(2.0) * s_m
-        q_prev2 = 0.0
-        q_prev = q_mm
-        for n in range(m, degree + 1):
-            if n == m:
-                q = q_mm
-            elif n == m + 1:
-                q = math.sqrt(2 * m + 3) * x * q_mm
-            else:
-                alpha = math.sqrt((4 * n * n - 1) / (n * n - m * m))
-                beta = math.sqrt(((n - 1) ** 2 - m * m) / (4 * (n - 1) ** 2 - 1))
-                q = alpha * (x * q_prev - beta * q_prev2)
-            if n > m:
-                q_prev2, q_prev = q_prev, q
+        # At m = 0, s_m = 0, so the sine term adds nothing.
+        wc = c_m if m == 0 else root2 * c_m
+        ws = root2 * s_m
+        k = m * m + 2 * m
+        total += q_mm * (a[k] * wc + a[k - 2 * m] * ws)
+        if m == degree:
+            break
+        q_prev2 = q_mm
+        q_prev = math.sqrt(2 * m + 3) * x * q_mm
+        k = (m + 1) * (m + 1) + (m + 1)
+        total += q_prev * (a[k + m] * wc + a[k - m] * ws)
+        for n in range(m + 2, degree + 1):
+            q = alpha[n, m] * (x * q_prev - beta[n, m] * q_prev2)
+            q_prev2, q_prev = q_prev, q
             k = n * n + n
-            total += a[k + m] * q * wc
-            if m > 0:
-                total += a[k - m] * q * ws
+            total += q * (a[k + m] * wc + a[k - m] * ws)
     return total
 
 
 @njit(cache=True)
-def _evaluate_many(a, u, out):
-    degree = int(math.sqrt(a.shape[0]) + 0.5) - 1
+def _evaluate_many(a, alpha, beta, u, out):
+    degree = alpha.shape[0] - 1
     for i in range(u.shape[0]):
-        out[i] = evaluate_one(a, degree, u[i, 0], u[i, 1], u[i, 2])
+        out[i] = evaluate_one(a, degree, alpha, beta, u[i, 0], u[i, 1], u[i, 2])
 
 
 def rotate_coefficients(coefficients: np.ndarray, rotation: np.ndarray) -> np.ndarray:

@@ -35,6 +35,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from . import harmonics as sh
 
@@ -66,8 +67,17 @@ class MassProperties:
 def mass_properties(coefficients: np.ndarray) -> MassProperties:
     """Exact volume, centroid and central inertia tensor (see the module docstring)."""
     degree = sh.degree_of(coefficients)
-    grid = _moment_grid(degree)
-    return _mass_properties_on(coefficients, grid)
+    grid = sh.gauss_grid(degree, 5 * degree + 2)
+    r = sh.synthesize(coefficients, grid).ravel()
+    w = grid.weights.ravel()
+    u = grid.directions.reshape(-1, 3)
+    vol = float((r ** 3 * w).sum() / 3.0)
+    centroid = (r ** 4 * w) @ u / (4.0 * vol)
+    second = (u * (r ** 5 * w)[:, None]).T @ u / 5.0
+    inertia_origin = np.trace(second) * np.eye(3) - second
+    shift = centroid @ centroid * np.eye(3) - np.outer(centroid, centroid)
+    inertia = inertia_origin - vol * shift
+    return MassProperties(vol, centroid, inertia)
 
 
 def volume(coefficients: np.ndarray) -> float:
@@ -77,44 +87,33 @@ def volume(coefficients: np.ndarray) -> float:
     return float((sh.synthesize(coefficients, grid) ** 3 * grid.weights).sum() / 3.0)
 
 
-def _moment_grid(degree: int) -> sh.GaussGrid:
-    return sh.gauss_grid(degree, 5 * degree + 2)
-
-
-def _mass_properties_on(coefficients, grid) -> MassProperties:
-    r = sh.synthesize(coefficients, grid)
-    w = grid.weights
-    u = grid.directions
-    vol = float((r ** 3 * w).sum() / 3.0)
-    centroid = np.einsum("ij,ijk->k", r ** 4 * w, u) / (4.0 * vol)
-    r5w = r ** 5 * w
-    second = np.einsum("ij,ijk,ijl->kl", r5w, u, u) / 5.0
-    inertia_origin = np.trace(second) * np.eye(3) - second
-    inertia = inertia_origin - vol * (centroid @ centroid * np.eye(3) - np.outer(centroid, centroid))
-    return MassProperties(vol, centroid, inertia)
-
-
-def radius_bounds(coefficients: np.ndarray, oversampling: int = 4) -> tuple[float, float]:
+def radius_bounds(coefficients: np.ndarray, oversampling: int = 8) -> tuple[float, float]:
     """Rigorous bounds (r_lo ≤ min r, max r ≤ r_hi) [length] of the radius function.
 
     r is sampled on a Gauss grid ``oversampling`` times finer than the degree needs; between
     nodes r cannot exceed the sampled extreme by more than ½δ²·Σ_n n²‖r_n‖∞, with δ the largest
     angular distance to a node and ‖r_n‖∞ ≤ √((2n+1)/(4π)) ‖a_n‖₂ (Bernstein's inequality on a
-    great circle through the extremum, where the first derivative vanishes). ``r_hi`` is the
-    support radius used for neighbour search: no point of the body lies farther from the origin.
+    great circle through the extremum, where the first derivative vanishes), plus a bound on
+    the rounding of the synthesis. ``r_hi`` is the support radius used for neighbour search:
+    no point of the body lies farther from the origin.
     """
     degree = sh.degree_of(coefficients)
     grid = sh.gauss_grid(degree, oversampling * max(degree, 4))
     r = sh.synthesize(coefficients, grid)
     theta = np.arccos(grid.x)
-    d_theta = np.max(np.abs(np.diff(np.concatenate([[math.pi], theta, [0.0]]))))
+    d_theta = np.max(np.abs(np.diff(theta)))
     d_phi = grid.phi[1] - grid.phi[0]
-    delta = 0.5 * math.hypot(d_theta, d_phi)
+    # Between rings a point is within half a cell diagonal of a node; a pole is one ring gap
+    # away from every node of the nearest ring.
+    delta = max(0.5 * math.hypot(d_theta, d_phi), math.pi - theta.max(), theta.min())
     n, _ = sh.coefficient_degree(degree)
     norms = np.sqrt(np.bincount(n, weights=coefficients ** 2))
     curvature_bound = np.sum(np.arange(degree + 1) ** 2 * np.sqrt((2 * np.arange(degree + 1) + 1)
                                                                   / (4 * math.pi)) * norms)
-    slack = 0.5 * delta ** 2 * curvature_bound
+    # Rounding of the synthesis: a few ulps of the largest possible |r| = Σ_n ‖r_n‖∞.
+    rounding = 64 * np.finfo(float).eps * np.sum(np.sqrt((2 * np.arange(degree + 1) + 1)
+                                                          / (4 * math.pi)) * norms)
+    slack = 0.5 * delta ** 2 * curvature_bound + rounding
     return float(r.min() - slack), float(r.max() + slack)
 
 
@@ -173,35 +172,53 @@ def surface_geometry(coefficients: np.ndarray, directions: np.ndarray) -> Surfac
 def _radius_derivatives(a: np.ndarray, theta: np.ndarray, phi: np.ndarray):
     """r, r_θ, r_φ, r_θθ, r_θφ, r_φφ at (θ, φ) with sin θ bounded away from 0."""
     degree = sh.degree_of(a)
-    x, s = np.cos(theta), np.sin(theta)
-    p = sh.legendre(degree, x)
-    n_all = np.arange(degree + 1)[:, None, None]
-    m_all = np.arange(degree + 1)[None, :, None]
-    p_lower = np.zeros_like(p)
-    p_lower[1:] = p[:-1]
+    alpha, beta = sh.recurrence_tables(degree)
+    n = np.arange(degree + 1, dtype=np.float64)[:, None]
+    m = np.arange(degree + 1, dtype=np.float64)[None, :]
     with np.errstate(divide="ignore", invalid="ignore"):
-        factor = np.sqrt(np.maximum(0.0, (2 * n_all + 1) * (n_all ** 2 - m_all ** 2)
-                                    / (2 * n_all - 1.0)))
-    factor = np.nan_to_num(factor)
-    dp = (n_all * x * p - factor * p_lower) / s
-    d2p = -(x / s) * dp - (n_all * (n_all + 1) - m_all ** 2 / s ** 2) * p
-    values = [np.zeros_like(x) for _ in range(6)]
-    for m in range(degree + 1):
-        n = np.arange(m, degree + 1)
-        weight = 1.0 if m == 0 else math.sqrt(2.0)
-        cos_m, sin_m = weight * np.cos(m * phi), weight * np.sin(m * phi)
-        a_c = a[n * n + n + m]
-        a_s = a[n * n + n - m] if m > 0 else np.zeros_like(a_c)
-        for k, table in ((0, p), (1, dp), (3, d2p)):
-            c = a_c @ table[m:, m]
-            s_ = a_s @ table[m:, m]
-            values[k] += c * cos_m + s_ * sin_m
-            if k == 0:
-                values[2] += m * (s_ * cos_m - c * sin_m)
-                values[5] += -m * m * (c * cos_m + s_ * sin_m)
-            elif k == 1:
-                values[4] += m * (s_ * cos_m - c * sin_m)
-    return values
+        lower = np.sqrt((2 * n + 1) * (n * n - m * m) / (2 * n - 1))
+    lower = np.where(n > m, lower, 0.0)
+    out = np.empty((6, len(theta)))
+    _derivatives_many(np.ascontiguousarray(a, dtype=np.float64), alpha, beta, lower,
+                      np.asarray(theta, dtype=np.float64), np.asarray(phi, dtype=np.float64), out)
+    return list(out)
+
+
+@njit(cache=True)
+def _derivatives_many(a, alpha, beta, lower, theta, phi, out):
+    degree = alpha.shape[0] - 1
+    root2 = math.sqrt(2.0)
+    for i in range(theta.shape[0]):
+        x, s = math.cos(theta[i]), math.sin(theta[i])
+        c1, s1 = math.cos(phi[i]), math.sin(phi[i])
+        cos_m, sin_m = 1.0, 0.0
+        p_mm = 1.0 / math.sqrt(4.0 * math.pi)
+        r = r_t = r_p = r_tt = r_tp = r_pp = 0.0
+        for m in range(degree + 1):
+            if m > 0:
+                p_mm *= math.sqrt((2 * m + 1) / (2 * m)) * s
+                cos_m, sin_m = cos_m * c1 - sin_m * s1, sin_m * c1 + cos_m * s1
+            weight = 1.0 if m == 0 else root2
+            p_prev = 0.0
+            p = p_mm
+            for n in range(m, degree + 1):
+                if n == m + 1:
+                    p_prev, p = p, math.sqrt(2 * m + 3) * x * p
+                elif n > m + 1:
+                    p_prev, p = p, alpha[n, m] * (x * p - beta[n, m] * p_prev)
+                dp = (n * x * p - lower[n, m] * p_prev) / s
+                d2p = -(x / s) * dp - (n * (n + 1) - m * m / (s * s)) * p
+                k = n * n + n
+                even = weight * (a[k + m] * cos_m + a[k - m] * sin_m)
+                odd = weight * m * (a[k - m] * cos_m - a[k + m] * sin_m)
+                r += p * even
+                r_t += dp * even
+                r_tt += d2p * even
+                r_p += p * odd
+                r_tp += dp * odd
+                r_pp -= m * m * p * even
+        out[0, i], out[1, i], out[2, i] = r, r_t, r_p
+        out[3, i], out[4, i], out[5, i] = r_tt, r_tp, r_pp
 
 
 def _col(values: np.ndarray) -> np.ndarray:
