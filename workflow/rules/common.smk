@@ -1,8 +1,14 @@
 # Validation of the configuration and the material sheets, and the helpers the rules use.
+import math
+import sys
 from pathlib import Path
 
 import yaml
 from snakemake.utils import validate
+
+from suspsim.errors import SuspsimError
+from suspsim.io.provenance import code_version
+from suspsim.rheology.readers import read_flow_curve
 
 
 validate(config, "../schemas/config.schema.yaml")
@@ -13,6 +19,22 @@ RESULTS = Path(config["results_dir"])
 
 wildcard_constraints:
     material=r"[A-Za-z0-9_.-]+",
+    phi=r"[0-9.e+-]+",
+    rate=r"[0-9.e+-]+",
+    seed=r"[0-9]+",
+
+# Fingerprints of the package code each stage runs: a param, so editing the (editable-installed)
+# package re-runs exactly the stages whose code changed.
+CODE = {
+    "fit_matrix": code_version("suspsim.stages.fit"),
+    "predict_homogenisation": code_version("suspsim.stages.homogenisation"),
+    "simulate": code_version("suspsim.stages.simulate"),
+    "gather": code_version("suspsim.stages.gather"),
+    "plot_summary": code_version("suspsim.stages.summary_figure", "suspsim.plotting.summary"),
+}
+SIMULATION = config["simulation"]
+RESOLUTION = {key: SIMULATION[key] for key in ("box", "number_density", "strain", "transient",
+                                               "reynolds", "jitter")}
 
 
 def _discover_materials():
@@ -68,6 +90,58 @@ def volume_fractions(wildcards):
     return MATERIALS[wildcards.material].get("volume_fractions") or config["homogenisation"]["volume_fractions"]
 
 
+def number_tag(value):
+    """A number as it appears in a file name: the short form when it is exact, else repr."""
+    short = f"{value:g}"
+    return short if float(short) == float(value) else repr(float(value))
+
+
+def _rounded(value, digits=2):
+    return round(value, digits - 1 - math.floor(math.log10(value)))
+
+
+def _default_rates(material):
+    """rate_count rates at the centres of equal log-intervals of the measured range.
+
+    An unreadable matrix file gives none: its fit job fails with the reader's message, and the
+    material's gather, which needs the fit, never runs.
+    """
+    try:
+        data = read_flow_curve(MATRIX_FILES[material],
+                               sample=MATERIALS[material]["matrix"]["sample"])
+    except SuspsimError as err:
+        print(f"no default shear rates for {material}: {err}", file=sys.stderr)
+        return []
+    low, high = math.log10(data["shear_rate"].min()), math.log10(data["shear_rate"].max())
+    count = SIMULATION["rate_count"]
+    return [_rounded(10 ** (low + (i + 0.5) * (high - low) / count)) for i in range(count)]
+
+
+SHEAR_RATES = {m: SIMULATION["shear_rates"] or _default_rates(m) for m in MATERIALS}
+
+
+def run_files(wildcards):
+    """Every run file of a material: volume fractions x shear rates x seeds."""
+    return [f"{RESULTS}/{wildcards.material}/runs/phi-{number_tag(phi)}_rate-{number_tag(rate)}"
+            f"_seed-{seed}.nc"
+            for phi in SIMULATION["volume_fractions"]
+            for rate in SHEAR_RATES[wildcards.material]
+            for seed in SIMULATION["seeds"]]
+
+
+def run_shear_rate(wildcards):
+    return float(wildcards.rate)
+
+
+def run_volume_fraction(wildcards):
+    return float(wildcards.phi)
+
+
+def run_seed(wildcards):
+    return int(wildcards.seed)
+
+
 def all_outputs():
-    names = ("fit.json", "fit.png", "homogenisation.nc", "homogenisation.png")
+    names = ("fit.json", "fit.png", "homogenisation.nc", "homogenisation.png", "summary.nc",
+             "summary.png")
     return [str(RESULTS / m / name) for m in MATERIALS for name in names]

@@ -21,5 +21,6 @@ rule fit_matrix:
         sample=fit_sample,
         criterion=config["fit"]["criterion"],
         candidates=config["fit"]["candidates"],
+        code=CODE["fit_matrix"],
     script:
         "../scripts/fit_matrix.py"

@@ -19,5 +19,6 @@ rule predict_homogenisation:
     params:
         volume_fractions=volume_fractions,
         phi_max=config["homogenisation"]["phi_max"],
+        code=CODE["predict_homogenisation"],
     script:
         "../scripts/predict_homogenisation.py"

@@ -119,3 +119,48 @@ RUN_ATTRIBUTES: Mapping[str, Attribute] = MappingProxyType({a.name: a for a in (
 
 #: Run attributes every output must set.
 REQUIRED_RUN_ATTRIBUTES = ("wall_time_s", "completed")
+
+
+# Packing files (suspsim.io.packing_file): one row per body.
+_VOLUME = (0, 0, 0, 1)
+_B = ("body",)
+
+PACKING_VARIABLES: Mapping[str, Variable] = MappingProxyType({v.name: v for v in (
+    Variable("centre", _B + ("axis",), "position of the body-frame origin in the box (sphere "
+             "centre, grain centroid)", _LENGTH,
+             comment="the box is [0, Lx) x [0, Ly) x [0, Lz), periodic; bodies may cross faces"),
+    Variable("orientation", _B + ("quaternion",), "unit quaternion (w, x, y, z) rotating the "
+             "body frame into the box frame"),
+    Variable("radius", _B, "volume-equivalent radius (sphere radius)", _LENGTH),
+    Variable("volume", _B, "body volume", _VOLUME),
+    Variable("support_radius", _B, "upper bound of the distance from the body-frame origin to "
+             "the surface", _LENGTH),
+    Variable("shape_coefficient", _B + ("coefficient",), "real spherical-harmonic coefficient "
+             "a_nm of the surface radius r(theta, phi) in the body frame", _LENGTH,
+             comment="r = sum a_nm Y_nm, orthonormal real harmonics without Condon-Shortley "
+                     "phase, flat index n*n + n + m (suspsim.bodies.harmonics)"),
+    Variable("coefficient_degree", ("coefficient",), "degree n of each shape coefficient"),
+    Variable("coefficient_order", ("coefficient",), "order m of each shape coefficient"),
+)})
+
+PACKING_ATTRIBUTES: Mapping[str, Attribute] = MappingProxyType({a.name: a for a in (
+    Attribute("shape", str, "body shape: sphere or sand"),
+    Attribute("volume_fraction", float, "sum of body volumes over box volume [1]"),
+    Attribute("seed", int, "seed of numpy.random.default_rng that produced the packing"),
+    Attribute("box", tuple, "box lengths Lx, Ly, Lz [h]"),
+    Attribute("body_count", int, "number of bodies"),
+    Attribute("polydispersity", float, "coefficient of variation of the radius distribution "
+              "asked for [1]"),
+    Attribute("size_ratio", float, "bound on largest/smallest radius [1]"),
+    Attribute("min_gap", float, "smallest gap guaranteed between bodies [h] (sand: radial)"),
+    Attribute("smallest_gap", float, "smallest gap found by the exact check [h]"),
+    Attribute("relaxation_steps", int, "FIRE steps of the overlap removal"),
+    Attribute("wall_time_s", float, "wall-clock time of the packing [s]"),
+    Attribute("degree", int, "spherical-harmonic degree N of the grain shapes"),
+    Attribute("roughness", float, "rms radius deviation of degrees >= 3 [equivalent radius]"),
+    Attribute("spectral_exponent", float, "p in |a_nm| ~ n^-p for degrees >= 3"),
+    Attribute("elongation_range", tuple, "range of the elongation L/W drawn [1]"),
+    Attribute("relax_points", int, "surface sample points per grain in the relaxation"),
+    Attribute("check_points", int, "surface sample points per grain in the exact check"),
+    Attribute("working_gap", float, "gap the relaxation worked with [h]"),
+)})

@@ -1,0 +1,228 @@
+"""Stage 3: one SPH simulation per (material, φ, γ̇, seed), results back in physical units.
+
+From the matrix fit (``fit.json``, SI) and a physical shear rate γ̇ [1/s], :func:`simulation_scene`
+maps the law to simulation units (:mod:`suspsim.units`, SPEC §7) and builds a Lees–Edwards
+Couette scene (SPEC §2.7) of a cubic box; :func:`simulate_run` runs it through
+:func:`suspsim.run.run_scene` (checkpoints, health checks, atomic write) and writes one run file
+holding the run in simulation units plus its results converted back:
+
+    η = S_μ ⟨σ_xy⟩_sim / γ̇_sim                  [Pa s]   suspension viscosity (SPEC §2.8)
+    μ_m = μ(γ̇)                                   [Pa s]   the fitted matrix law
+    η_r = η / μ_m = ⟨σ_xy⟩_sim / (γ̇_sim μ_sim(γ̇_sim))  [1]
+
+with standard errors from the run's batch means. At φ = 0 the box holds the matrix alone, so
+η_r = 1 within its error checks the solver against the fitted law at each rate.
+
+The run starts from the linear profile (``run.start = linear``): the step is then limited by
+μ(γ̇/2) rather than the zero-rate viscosity (:mod:`suspsim.sph.timestep`), which for a
+yield-stress matrix is many orders of magnitude cheaper.
+
+Rigid inclusions (φ > 0) are not available yet: :func:`simulation_scene` raises
+:class:`InclusionsNotAvailable`.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import os
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import xarray as xr
+
+from ..errors import InputError, SuspsimError
+from ..io.atomic import atomic_path
+from ..io.checkpoint import load_checkpoint
+from ..io.netcdf import read_run
+from ..io.study_variables import STUDY_VARIABLES
+from ..rheology.laws import ConstitutiveLaw, make_law
+from ..run import checkpoint_path, run_scene
+from ..scene import Scene, scene_from_dict
+from ..units import DEFAULT_REYNOLDS, UnitMapping, unit_mapping
+
+log = logging.getLogger(__name__)
+
+#: Suffix of the simulation-unit run file written by run_scene before the physical results are
+#: added; its checkpoint (``+ .ckpt.npz``) lets an interrupted job resume.
+SIMULATION_SUFFIX = ".sim.nc"
+
+
+class InclusionsNotAvailable(SuspsimError, NotImplementedError):
+    """φ > 0 asks for rigid inclusions, which the solver does not build yet."""
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Numerical resolution of a study's runs.
+
+    ``box`` cubic box side [h]; ``number_density`` [h⁻³] (box/spacing must be whole);
+    ``strain`` total strain [1]; ``transient`` strain discarded before averaging [1];
+    ``reynolds`` target particle Re [1] (SPEC §7); ``jitter`` initial lattice disorder
+    [spacings], seeded by the run's seed.
+    """
+
+    box: float
+    number_density: float
+    strain: float
+    transient: float
+    reynolds: float = DEFAULT_REYNOLDS
+    jitter: float = 0.0
+
+    @classmethod
+    def from_mapping(cls, data: Mapping[str, Any], source: str = "resolution") -> "Resolution":
+        """From a config block; unknown keys or missing required ones raise InputError."""
+        names = set(cls.__dataclass_fields__)
+        unknown = sorted(set(data) - names)
+        if unknown:
+            raise InputError(source, f"unknown resolution key(s) {', '.join(unknown)}; "
+                             f"known: {', '.join(sorted(names))}")
+        try:
+            return cls(**{k: float(v) for k, v in data.items()})
+        except TypeError as err:
+            raise InputError(source, f"incomplete resolution: {err}") from None
+        except ValueError as err:
+            raise InputError(source, f"resolution values must be numbers: {err}") from None
+
+
+def read_fit(path: str | os.PathLike) -> dict:
+    """The fit report ``fit.json`` as a dict; InputError if unreadable or without a law."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            fit = json.load(fh)
+        make_law(fit["law"], fit["params"])
+    except FileNotFoundError:
+        raise InputError(path, "no such fit report; run the fit stage first") from None
+    except (OSError, json.JSONDecodeError, KeyError, TypeError, ValueError) as err:
+        raise InputError(path, f"not a usable fit report ({err})") from None
+    return fit
+
+
+def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction: float,
+                     seed: int, resolution: Resolution,
+                     threads: int | None = 1) -> tuple[Scene, UnitMapping]:
+    """The Couette scene of physical ``shear_rate`` [1/s] for ``law`` (SI) and its mapping.
+
+    Raises :class:`InclusionsNotAvailable` for ``volume_fraction`` > 0, InputError for a bad
+    rate, φ, seed or resolution (e.g. a box that is not a whole number of lattice spacings).
+    """
+    if not 0.0 <= volume_fraction < 1.0:
+        raise InputError("simulation", f"volume fraction {volume_fraction!r} must be in [0, 1)")
+    if volume_fraction > 0:
+        raise InclusionsNotAvailable(
+            f"volume fraction {volume_fraction:g} needs rigid inclusions (packings and rigid "
+            "bodies in the SPH solver, SPEC §3), which are not available yet; simulate phi = 0 "
+            "only for now")
+    mapping = unit_mapping(law, shear_rate, density=resolution.number_density,
+                           reynolds_number=resolution.reynolds)
+    sim_law = mapping.law_to_simulation(law)
+    data = {"dimension": 3, "box": [resolution.box] * 3,
+            "number_density": resolution.number_density,
+            "fluid": {"law": sim_law.name, "params": dict(sim_law.params)},
+            "flow": {"type": "couette", "shear_rate": mapping.simulation_shear_rate},
+            "run": {"strain": resolution.strain, "transient": resolution.transient,
+                    "start": "linear", "threads": "all" if threads is None else int(threads)},
+            "lattice": {"jitter": resolution.jitter},
+            "inclusions": {"volume_fraction": float(volume_fraction)},
+            "seed": int(seed)}
+    return scene_from_dict(data, source="simulation resolution"), mapping
+
+
+def simulate_run(fit_json: str | os.PathLike, out_nc: str | os.PathLike, *, shear_rate: float,
+                 volume_fraction: float, seed: int, resolution: Mapping[str, Any] | Resolution,
+                 threads: int | None = 1) -> xr.Dataset:
+    """Simulate one (φ, γ̇, seed) of the matrix in ``fit_json`` and write ``out_nc`` atomically.
+
+    The simulation-unit run goes first to ``out_nc`` with :data:`SIMULATION_SUFFIX` (and its
+    checkpoint); a checkpoint of the same scene left by an interrupted job is resumed, one of
+    another scene is discarded. Returns the written Dataset.
+
+    Raises InputError (fit report, parameters), :class:`InclusionsNotAvailable` (φ > 0),
+    NumericalError (blow-up; the checkpoint is kept) or :class:`suspsim.run.RunInterrupted`.
+    """
+    fit = read_fit(fit_json)
+    law = make_law(fit["law"], fit["params"])
+    if not isinstance(resolution, Resolution):
+        resolution = Resolution.from_mapping(resolution)
+    scene, mapping = simulation_scene(law, shear_rate, volume_fraction=volume_fraction,
+                                      seed=seed, resolution=resolution, threads=threads)
+    low, high = fit.get("shear_rate_range", (shear_rate, shear_rate))
+    if not low <= shear_rate <= high:
+        log.warning("shear rate %g 1/s lies outside the measured range %g–%g 1/s: the matrix law "
+                    "is extrapolated", shear_rate, low, high)
+    out = Path(out_nc)
+    sim_path = out.with_suffix(SIMULATION_SUFFIX)
+    log.info("%s at %g 1/s: time scale %.4g s/tau, viscosity scale %.4g Pa s, particle Re %g; "
+             "law in simulation units %s", law.name, shear_rate, mapping.time_scale,
+             mapping.viscosity_scale, mapping.reynolds_number, dict(scene.fluid.law.params))
+    run_scene(scene, sim_path, resume=_resumable(sim_path, scene), threads=threads)
+    run = read_run(sim_path)
+    dataset = with_physical_results(run, mapping, scene=scene, volume_fraction=volume_fraction,
+                                    seed=seed, resolution=resolution, fit=fit)
+    with atomic_path(out) as tmp:
+        dataset.to_netcdf(tmp, engine="netcdf4",
+                          encoding={name: {"_FillValue": None} for name in dataset.coords})
+    sim_path.unlink(missing_ok=True)
+    log.info("wrote %s: viscosity %.5g ± %.2g Pa s, matrix %.5g Pa s, relative %.4f ± %.4f",
+             out, float(dataset["suspension_viscosity"]),
+             float(dataset["suspension_viscosity_stderr"]), float(dataset["matrix_viscosity"]),
+             float(dataset["relative_viscosity"]), float(dataset["relative_viscosity_stderr"]))
+    return dataset
+
+
+def with_physical_results(run: xr.Dataset, mapping: UnitMapping, *, scene: Scene,
+                          volume_fraction: float, seed: int, resolution: Resolution,
+                          fit: Mapping) -> xr.Dataset:
+    """``run`` (simulation units) plus its results in physical units and the unit mapping.
+
+    Adds the 0-d variables of :data:`~suspsim.io.study_variables.STUDY_VARIABLES` (φ, γ̇ and
+    seed as scalar coordinates, so gathered runs combine by coordinate) and the mapping as
+    ``unit_*`` global attributes, with the run's Mach number.
+    """
+    mapping = mapping.with_mach(float(run.attrs["mach_number"]))
+    mu_sim = float(scene.fluid.law.viscosity(mapping.simulation_shear_rate))
+    eta_sim, err_sim = float(run["viscosity"]), float(run["viscosity_stderr"])
+    values = {"suspension_viscosity": float(mapping.viscosity_to_physical(eta_sim)),
+              "suspension_viscosity_stderr": float(mapping.viscosity_to_physical(err_sim)),
+              "matrix_viscosity": mapping.matrix_viscosity,
+              "relative_viscosity": eta_sim / mu_sim,
+              "relative_viscosity_stderr": err_sim / mu_sim,
+              "wall_time": float(run.attrs["wall_time_s"]),
+              "n_particles": float(run.attrs["n_particles"]),
+              "box_side": resolution.box, "number_density": resolution.number_density,
+              "total_strain": resolution.strain, "transient_strain": resolution.transient,
+              "particle_reynolds_number": mapping.reynolds_number,
+              "reynolds_number": float(run.attrs["reynolds_number"]),
+              "mach_number": mapping.mach_number,
+              "time_scale": mapping.time_scale, "viscosity_scale": mapping.viscosity_scale}
+    coords = {"phi": float(volume_fraction), "shear_rate": mapping.shear_rate, "seed": int(seed)}
+    clashes = sorted((set(values) | set(coords)) & set(run.variables))
+    if clashes:
+        raise ValueError(f"study variables {clashes} would overwrite the run's own")
+    out = run.copy()
+    for name, value in values.items():
+        out[name] = xr.Variable((), value, attrs=STUDY_VARIABLES[name].attrs())
+    out = out.assign_coords({name: xr.Variable((), value, attrs=STUDY_VARIABLES[name].attrs())
+                             for name, value in coords.items()})
+    out.attrs.update(mapping.to_attributes())
+    out.attrs["resolution"] = json.dumps(asdict(resolution))
+    out.attrs["matrix_fit"] = json.dumps({"law": fit["law"], "params": fit["params"],
+                                          "source": fit.get("source")}, ensure_ascii=False)
+    out.attrs["title"] = (f"suspsim study run: {fit['law']} matrix, phi = {volume_fraction:g}, "
+                          f"shear rate {mapping.shear_rate:g} 1/s, seed {seed}")
+    return out
+
+
+def _resumable(sim_path: Path, scene: Scene) -> bool:
+    """True when a checkpoint of this very scene is waiting; one of another scene is removed."""
+    ckpt = checkpoint_path(sim_path)
+    if not ckpt.exists():
+        return False
+    try:
+        load_checkpoint(ckpt, scene)
+    except InputError as err:
+        log.warning("discarding %s: %s", ckpt, err)
+        ckpt.unlink()
+        return False
+    log.info("resuming the interrupted run from %s", ckpt)
+    return True

@@ -1,0 +1,21 @@
+# Stage 3: one SPH simulation per material x volume fraction x shear rate x seed (SPEC 2.7, 7).
+
+
+rule simulate:
+    input:
+        fit=f"{RESULTS}/{{material}}/fit.json",
+    output:
+        run=f"{RESULTS}/{{material}}/runs/phi-{{phi}}_rate-{{rate}}_seed-{{seed}}.nc",
+    log:
+        "logs/simulate/{material}/phi-{phi}_rate-{rate}_seed-{seed}.log",
+    benchmark:
+        "logs/benchmarks/simulate/{material}/phi-{phi}_rate-{rate}_seed-{seed}.tsv"
+    threads: SIMULATION["threads"]
+    params:
+        shear_rate=run_shear_rate,
+        volume_fraction=run_volume_fraction,
+        seed=run_seed,
+        resolution=RESOLUTION,
+        code=CODE["simulate"],
+    script:
+        "../scripts/simulate.py"
