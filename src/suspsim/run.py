@@ -19,7 +19,9 @@ removed once the output is written. An interrupted run raises :class:`RunInterru
 Output (:mod:`suspsim.io.netcdf`): the time series, the steady-window profiles, and for couette
 ``viscosity`` = ⟨σ_xy⟩/γ̇ with ``viscosity_stderr`` from
 :func:`~suspsim.analysis.steady.steady_mean` (batch means over ≥ 8 blocks of whole strain
-units). A poiseuille flow has no single viscosity: both are omitted (its viscosity lives in
+units); with inclusions also ``phi``, ``suspension_viscosity`` (the same ⟨σ_xy⟩/γ̇),
+``matrix_viscosity_at_rate`` μ(γ̇) of the scene's law and ``relative_viscosity`` (± stderr)
+η_r = ⟨σ_xy⟩/(γ̇ μ(γ̇)) (SPEC §3.5). A poiseuille flow has no single viscosity: both are omitted (its viscosity lives in
 ``viscosity_profile``). The Reynolds number's scales are those of :mod:`suspsim.analysis.steady`.
 """
 from __future__ import annotations
@@ -246,6 +248,12 @@ def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall
         log.info("viscosity %.6g ± %.2g (%s, %d blocks of %g, %d samples)", data["viscosity"],
                  data["viscosity_stderr"], estimate.method, estimate.n_blocks,
                  estimate.block_size, estimate.n_used)
+        if scene.inclusions.present:
+            matrix = float(scene.fluid.law.viscosity(scene.flow.shear_rate))
+            data.update(phi=float(sim.packing_phi), suspension_viscosity=data["viscosity"],
+                        matrix_viscosity_at_rate=matrix,
+                        relative_viscosity=data["viscosity"] / matrix,
+                        relative_viscosity_stderr=data["viscosity_stderr"] / matrix)
     data["y"] = record.sums["y"]
     for name in PROFILE_NAMES:
         data[name] = record.sums[name] / record.n_profiles
@@ -255,6 +263,8 @@ def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall
              "reynolds_number": reynolds_number(scene, data["velocity_profile"]),
              "mach_number": float(np.max(series["mach"])), "completed": True,
              "dt": sim.dt, "sound_speed": sim.sound_speed}
+    if getattr(sim, "bodies", None) is not None:
+        attrs.update(n_bodies=sim.bodies.count, n_body_particles=sim.n_body_particles)
     write_run(out, data, attrs, scene)
     log.info("wrote %s (Re %.3g, max Mach %.3g)", out, attrs["reynolds_number"],
              attrs["mach_number"])

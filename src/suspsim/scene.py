@@ -90,9 +90,14 @@ class RunSpec:
 
 @dataclass(frozen=True)
 class LatticeSpec:
-    """Initial lattice: ``jitter`` [lattice spacings], uniform in ±jitter per coordinate."""
+    """Initial lattice: ``jitter`` [lattice spacings], uniform in ±jitter per coordinate;
+    ``relax`` the start (resolved: True/False), until the density error is below
+    ``relax_tolerance`` [1] or for at most ``relax_max_steps``."""
 
     jitter: float
+    relax: bool
+    relax_tolerance: float
+    relax_max_steps: int
 
 
 @dataclass(frozen=True)
@@ -102,14 +107,43 @@ class NumericsSpec:
     bulk_correction: bool
     viscous_normalisation: bool
     wi_target: float
+    shifting: float
     dt_viscous_coefficient: float
 
 
 @dataclass(frozen=True)
-class InclusionsSpec:
-    """Rigid inclusions (reserved): ``volume_fraction`` φ [1]."""
+class LubricationSpec:
+    """Lubrication between bodies (SPEC §3.3): ``enabled``, ``cutoff_gap`` s_c [h], ``min_gap``
+    s_min [h], ``repulsion`` k [1] (schema ``inclusions.lubrication``)."""
 
-    volume_fraction: float
+    enabled: bool
+    cutoff_gap: float
+    min_gap: float
+    repulsion: float
+
+
+@dataclass(frozen=True)
+class InclusionsSpec:
+    """Rigid inclusions (SPEC §3–4): ``shape`` sphere|sand, ``phi`` φ [1] (0: none), mean
+    ``radius`` a [h], ``polydispersity`` [1], ``size_ratio`` [1], packing ``min_gap`` [h],
+    ``packing`` file (None: pack from these keys), packing ``seed`` (None: the scene's),
+    ``fluid_margin`` [lattice spacings] (fluid sites nearer a surface are removed)."""
+
+    shape: str
+    phi: float
+    radius: float
+    polydispersity: float
+    size_ratio: float
+    min_gap: float
+    packing: str | None
+    seed: int | None
+    fluid_margin: float
+    lubrication: LubricationSpec
+
+    @property
+    def present(self) -> bool:
+        """True when the scene has bodies (φ > 0 or a packing file)."""
+        return self.phi > 0.0 or self.packing is not None
 
 
 @dataclass(frozen=True)
@@ -183,6 +217,24 @@ class Scene:
                 "inclusions": asdict(self.inclusions), "seed": self.seed}
 
 
+def _lattice(data: Mapping[str, Any], inclusions: Mapping[str, Any]) -> LatticeSpec:
+    relax = data["relax"]
+    if relax == "auto":
+        relax = float(inclusions["phi"]) > 0.0 or inclusions["packing"] is not None
+    return LatticeSpec(float(data["jitter"]), bool(relax), float(data["relax_tolerance"]),
+                       int(data["relax_max_steps"]))
+
+
+def _inclusions(data: Mapping[str, Any]) -> InclusionsSpec:
+    floats = ("phi", "radius", "polydispersity", "size_ratio", "min_gap", "fluid_margin")
+    lub = data["lubrication"]
+    values = {f.name: float(data[f.name]) if f.name in floats else data[f.name]
+              for f in fields(InclusionsSpec) if f.name != "lubrication"}
+    return InclusionsSpec(**values, lubrication=LubricationSpec(
+        bool(lub["enabled"]), float(lub["cutoff_gap"]), float(lub["min_gap"]),
+        float(lub["repulsion"])))
+
+
 def load_scene(path: str | PathLike) -> Scene:
     """Read and validate a scene file; raises :class:`InputError` with file, line and key."""
     data, lines = load_yaml(path)
@@ -222,7 +274,7 @@ def _build(data, source: str, lines: Mapping[tuple, int]) -> Scene:
     return Scene(dimension=full["dimension"], box=tuple(float(s) for s in full["box"]),
                  number_density=float(full["number_density"]), kernel=full["kernel"],
                  fluid=FluidSpec(law), flow=FlowSpec(**full["flow"]), run=RunSpec(**run),
-                 lattice=LatticeSpec(float(full["lattice"]["jitter"])),
+                 lattice=_lattice(full["lattice"], full["inclusions"]),
                  numerics=NumericsSpec(**numerics),
-                 inclusions=InclusionsSpec(float(full["inclusions"]["volume_fraction"])),
+                 inclusions=_inclusions(full["inclusions"]),
                  seed=int(full["seed"]), source=source)

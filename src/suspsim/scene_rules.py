@@ -40,6 +40,7 @@ def resolve(scene: dict, given_run: dict, fail: Fail) -> tuple[dict, Constitutiv
     out["flow"] = _check_flow(scene["flow"], fail)
     out["run"] = _resolve_run(scene["run"], given_run, out["flow"], scene["box"], fail)
     _check_lattice(out["dimension"], scene["box"], scene["number_density"], fail)
+    _check_inclusions(out, fail)
     return out, law
 
 
@@ -131,3 +132,18 @@ def _check_lattice(dim: int, box, n: float, fail: Fail) -> None:
              f"a {'x'.join(map(str, counts))} lattice gives {actual:.4g} particles per h^{dim} "
              f"in this box, {100 * (actual / n - 1):+.1f} % off number_density {n:g}; use box "
              f"sides that are multiples of the spacing {spacing:.4g} h, e.g. [{fitting}]")
+
+
+def _check_inclusions(scene: dict, fail: Fail) -> None:
+    inc = scene["inclusions"]
+    if not (inc["phi"] > 0 or inc["packing"] is not None):
+        return
+    if scene["dimension"] != 3:
+        fail(("inclusions",), "rigid inclusions need a 3-D scene")
+    if scene["flow"]["type"] != "couette":
+        fail(("inclusions",), "rigid inclusions run in couette flow only (the suspension "
+                              "viscosity); use flow.type: couette")
+    lub = inc["lubrication"]
+    if lub["enabled"] and not lub["min_gap"] < lub["cutoff_gap"]:
+        fail(("inclusions", "lubrication", "min_gap"),
+             f"min_gap {lub['min_gap']:g} must be below cutoff_gap {lub['cutoff_gap']:g}")

@@ -62,7 +62,7 @@ def test_minimal_scene_gets_every_default(tmp_path):
     assert (run.strain, run.time, run.dt, run.sound_speed, run.threads) == (10.0, None, None, None, None)
     assert (run.start, run.output_interval, run.transient, run.profile_bins) == ("linear", 0.05, 5.0, 12)
     assert (run.checkpoint_interval_s, run.max_density_error, run.max_mach) == (300.0, 0.05, 0.3)
-    assert scene.lattice.jitter == 0.0 and scene.inclusions.volume_fraction == 0.0
+    assert scene.lattice.jitter == 0.0 and scene.inclusions.phi == 0.0 and not scene.inclusions.present
     assert scene.numerics.bulk_correction is True and scene.numerics.viscous_normalisation is True
     assert (scene.numerics.wi_target, scene.numerics.dt_viscous_coefficient) == (1e-3, 0.05)
     assert scene.total_time == pytest.approx(1000.0) and scene.transient_time == pytest.approx(500.0)
@@ -101,15 +101,17 @@ BAD = [
     ("missing nested key", _edit("  type: couette\n", ""), "flow.type", 8, "missing key"),
     ("negative box", _edit("[12, 12, 12]", "[12, -12, 12]"), "box[1]", 2, "> 0"),
     ("unknown law", _edit("law: papanastasiou", "law: bingham"), "fluid.law", 6, "unknown law"),
-    ("volume fraction above 1", MINIMAL + "inclusions: {volume_fraction: 1.2}\n",
-     "inclusions.volume_fraction", 17, "< 1"),
+    ("volume fraction above 1", MINIMAL + "inclusions: {phi: 1.2}\n",
+     "inclusions.phi", 17, "< 0.64"),
+    ("unknown inclusion shape", MINIMAL + "inclusions: {shape: cube, phi: 0.1}\n",
+     "inclusions.shape", 17, "sphere"),
     ("non-numeric shear rate", _edit("shear_rate: 0.01", "shear_rate: fast"), "flow.shear_rate", 10,
      "not a number"),
     ("non-numeric box entry", _edit("[12, 12, 12]", "[12, abc, 12]"), "box[1]", 2, "not a number"),
     ("non-numeric law parameter", _edit("mu_0: 99.0", "mu_0: lots"), "fluid.params.mu_0", 7, "not a number"),
     ("unknown top-level key", MINIMAL + "colour: red\n", "colour", 17, "unknown key"),
     ("unknown nested key", _edit("  dt: auto", "  dtt: auto"), "run.dtt", 14, "did you mean 'dt'"),
-    ("unknown numerics key", MINIMAL + "numerics:\n  shifting: true\n", "numerics.shifting", 18,
+    ("unknown numerics key", MINIMAL + "numerics:\n  smoothing: true\n", "numerics.smoothing", 18,
      "unknown key"),
     ("strain and time", _edit("  strain: 10", "  strain: 10\n  time: 100"), "run.time", 14, "not both"),
     ("no run length", _edit("  strain: 10\n", ""), "run.strain", 12, "run length"),

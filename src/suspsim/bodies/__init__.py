@@ -11,6 +11,11 @@
 - :mod:`~suspsim.bodies.radius_table`: cube-map tables of r(u) for fast lookups;
 - :mod:`~suspsim.bodies.relax`: overlap removal by soft repulsion and FIRE;
 - :mod:`~suspsim.bodies.overlap`: exact overlap checks (sphere gaps, dense grain sampling);
+- :mod:`~suspsim.bodies.construction`: bodies as rigid shells of SPH particles (SPEC §3.1);
+- :mod:`~suspsim.bodies.rigid`: NO_SQUISH symplectic rotation of rigid bodies (SPEC §3.2);
+- :mod:`~suspsim.bodies.lubrication`, :mod:`~suspsim.bodies.lubrication_implicit`: pair
+  lubrication (Jeffrey–Onishi, correction form), repulsion, curved squeeze, implicit impulses
+  (SPEC §3.3–3.4);
 - :mod:`~suspsim.bodies.packing`: :func:`~suspsim.bodies.packing.pack_spheres`,
   :func:`~suspsim.bodies.packing.pack_sand` and the :class:`~suspsim.bodies.packing.Packing`
   they return (stored by :mod:`suspsim.io.packing_file`).

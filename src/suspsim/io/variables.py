@@ -93,6 +93,16 @@ VARIABLES: Mapping[str, Variable] = MappingProxyType({v.name: v for v in (
     Variable("density_profile", _Y, "time-averaged mass density per bin of y", _DENSITY),
     Variable("reference_velocity_profile", _Y, "analytic flow velocity v_x per bin of y", _VELOCITY,
              comment="continuum solution for the scene's law and flow (SPEC 6)"),
+    Variable("phi", (), "solid volume fraction of the rigid inclusions"),
+    Variable("suspension_viscosity", (), "suspension shear viscosity sigma_xy/shear_rate averaged "
+             "after the transient", _VISCOSITY,
+             comment="stress with body particles at their body centre (SPEC 3.5)"),
+    Variable("matrix_viscosity_at_rate", (), "matrix law viscosity at the imposed shear rate",
+             _VISCOSITY),
+    Variable("relative_viscosity", (), "suspension viscosity over the matrix viscosity at the "
+             "same shear rate"),
+    Variable("relative_viscosity_stderr", (), "standard error of relative_viscosity (block "
+             "averaging)"),
 )})
 
 
@@ -115,6 +125,8 @@ RUN_ATTRIBUTES: Mapping[str, Attribute] = MappingProxyType({a.name: a for a in (
     Attribute("completed", int, "1 if the run reached its end, 0 if it stopped early"),
     Attribute("dt", float, "time step used [tau]"),
     Attribute("sound_speed", float, "sound speed c used [h/tau]"),
+    Attribute("n_bodies", int, "number of rigid inclusions"),
+    Attribute("n_body_particles", int, "SPH particles in the bodies' surface shells"),
 )})
 
 #: Run attributes every output must set.

@@ -128,7 +128,8 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     calls["force sums"] = lambda: force_sums(
         nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._v, sim._rho, sim._volume,
         sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2, sim._alpha, sim._beta,
-        sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._pressure, sim._force_acc,
+        sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of, sim._pressure,
+        sim._force_acc,
         sim._scratch_6, sim._bounds, sim._virial)
     calls["force finish"] = lambda: force_finish(
         sim._force_acc, sim._x, sim._rho, sim._inverse_moment, sim._gradient, sim._mass,

@@ -22,7 +22,7 @@ from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.boundaries import lees_edwards_offset
-from suspsim.sph.density import mass_density, summation_density
+from suspsim.sph.density import body_particle_density, mass_density, summation_density
 from suspsim.sph.neighbours import needs_rebuild
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
@@ -64,7 +64,8 @@ def kick(velocities, accel, accel_new, dt):
 def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours,
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, normalise, alpha, beta, bulk_factor,
-                  bulk_gradient, rho, volume, pressure, pair_end, pair_j, geometry, gradient,
+                  bulk_gradient, has_bodies, body_of, rho, volume, pressure, pair_end, pair_j,
+                  geometry, gradient,
                   inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
                   viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6,
                   bounds, virial, accel_out):
@@ -72,12 +73,18 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
 
     ``velocity_gradient`` runs the gradient pass (needed by a non-Newtonian law or the
     normalisation); ``normalise`` the normalisation pass (else μ̂ must equal μ on entry);
-    ``bulk_gradient`` the ∇a sums (B on and μ varying).
+    ``bulk_gradient`` the ∇a sums (B on and μ varying). ``has_bodies``: the scene has rigid
+    bodies, whose particles (``body_of`` (N,) ≥ 0; −1 for fluid) take their density from the
+    fluid around them (``density.body_particle_density``) and skip pairs inside their own
+    body (``force_pass``).
     """
     shear_ly = shear_rate * box[1]
     summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
                       rho, pair_end, pair_j, geometry, scratch_1, bounds)
     mass_density(rho, mass, volume)
+    if has_bodies:
+        body_particle_density(nl_start, pair_end, pair_j, geometry, body_of, kernel, h, rho,
+                              rho_eq, c2, mass, dissipation, diss_acc, volume)
     if velocity_gradient:
         _gradient_sums(nl_start, pair_end, pair_j, geometry, predicted, volume, shear_ly,
                        dimension, grad_acc, scratch_15, bounds)
@@ -93,7 +100,7 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     elif not newtonian:
         viscosity_hat[:] = viscosity
     force_sums(nl_start, pair_end, pair_j, geometry, predicted, rho, volume, viscosity_hat, mass,
-               rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, pressure,
+               rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of, pressure,
                force_acc, scratch_6, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
@@ -104,8 +111,9 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   positions, velocities, accel, predicted, accel_new, box, nl_start,
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
-                  normalise, alpha, beta, bulk_factor, bulk_gradient, rho, volume, pressure,
-                  pair_end, pair_j, geometry, gradient, inverse_moment, moment_trace, strain,
+                  normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
+                  volume, pressure, pair_end, pair_j, geometry, gradient, inverse_moment,
+                  moment_trace, strain,
                   dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
                   force_acc, scratch_1, scratch_15, scratch_6, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, rebuild?).
@@ -127,8 +135,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
         accelerations(positions, predicted, box, offset, nl_start, nl_image_start,
                       nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate, body_force,
                       dimension, law_code, law_params, newtonian, velocity_gradient, normalise,
-                      alpha, beta, bulk_factor, bulk_gradient, rho, volume, pressure, pair_end,
-                      pair_j, geometry, gradient, inverse_moment, moment_trace, strain,
+                      alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
+                      volume, pressure, pair_end, pair_j, geometry, gradient, inverse_moment, moment_trace, strain,
                       dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
                       force_acc, scratch_1, scratch_15, scratch_6, bounds, virial, accel_new)
         kick(velocities, accel, accel_new, dt)

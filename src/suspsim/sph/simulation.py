@@ -8,6 +8,12 @@ pass when ``numerics.viscous_normalisation`` is on, the ∇a sums when ``numeric
 is on and μ varies. Couette flow uses Lees–Edwards boundaries; Poiseuille a periodic box with
 the split body force (SPEC §2.7).
 
+Rigid inclusions (``scene.inclusions``, SPEC §3): :mod:`~suspsim.sph.inclusions` builds the
+fluid and body particles; the bodies' state (:class:`~suspsim.bodies.system.RigidBodies`)
+advances beside the fluid's in a Python step loop that calls the same compiled passes, places
+the body particles rigidly (:mod:`~suspsim.bodies.coupling`) and sums their forces and torques.
+A scene without inclusions keeps the fully compiled loop and none of this.
+
 Particles are reordered (cell sort) and wrapped into the box at every neighbour-list rebuild,
 so per-particle arrays have no fixed identity. :meth:`Simulation.state` holds everything needed
 to continue bit for bit, including the positions at the last build (the list is rebuilt from
@@ -23,17 +29,20 @@ import time as time_module
 import numba
 import numpy as np
 
+from suspsim.bodies.coupling import body_force_torque, place_body_particles
+from suspsim.bodies.lubrication_pass import OVERLAPS, SMALLEST_GAP, lubrication_pass
 from suspsim.scene import Scene
 from suspsim.sph import kernels
 from suspsim.sph.boundaries import lees_edwards_offset
 from suspsim.sph.density import allocate_pair_table
-from suspsim.sph.integrator import accelerations, advance_steps
+from suspsim.sph.integrator import accelerations, advance_steps, drift, kick, predict
 from suspsim.sph.lattice import imposed_velocity, initial_velocities, lattice_positions
 from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbour_list,
-                                    build_neighbour_list, raise_for_code, rebuild_neighbour_list,
-                                    sort_by_cell)
+                                    build_neighbour_list, needs_rebuild, raise_for_code,
+                                    rebuild_neighbour_list, sort_by_cell)
 from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
 from suspsim.sph.terms.force_pass import FORCE_WIDTH
+from suspsim.sph.terms.shifting import shift_particles
 from suspsim.sph.terms.velocity_pass import GRADIENT_WIDTH
 from suspsim.sph.terms.viscous import bulk_factor, viscous_weights
 from suspsim.sph.timestep import auto_sound_speed, stable_time_step
@@ -44,12 +53,16 @@ log = logging.getLogger(__name__)
 SKIN = 0.2
 #: Support radius in scene units.
 SUPPORT = 1.0
+#: Velocity damping per relaxation step [1] and steps between its density checks [choice].
+RELAX_DAMPING = 0.05
+RELAX_CHECK = 10
 #: Per-particle arrays of :meth:`Simulation.state` (name → attribute).
 _STATE_ARRAYS = {"positions": "_x", "velocities": "_v", "accelerations": "_a",
                  "density": "_rho", "shear_rate": "_gdot", "viscosity": "_mu",
                  "normalisation_factor": "_factor", "viscosity_hat": "_mu_hat",
                  "velocity_gradient": "_gradient", "inverse_moment": "_inverse_moment",
-                 "virial": "_virial", "reference": "_reference"}
+                 "virial": "_virial", "reference": "_reference", "body_of": "_body_of",
+                 "body_offsets": "_offsets"}
 
 
 class Simulation:
@@ -73,13 +86,34 @@ class Simulation:
         self._rate = scene.flow.shear_rate if scene.flow.type == "couette" else 0.0
         self._body_force = scene.flow.body_force if scene.flow.type == "poiseuille" else 0.0
         self._mass = scene.mass
-        if _state is None:
+        self.bodies = None
+        self.packing = None
+        reference_count = None
+        if _state is not None:
+            positions, velocities = _state["positions"], _state["velocities"]
+            if "bodies" in _state:
+                from suspsim.bodies.system import RigidBodies
+
+                self.bodies = RigidBodies.from_state(_state["bodies"])
+                self._body_volume = float(_state["body_volume"])
+                self._body_radii = np.asarray(_state["body_radii"], dtype=float)
+                reference_count = int(_state["reference_count"])
+        elif scene.inclusions.present:
+            from suspsim.sph.inclusions import build_inclusions
+
+            setup = build_inclusions(scene)
+            positions, velocities = setup.positions, setup.velocities
+            self.bodies, self.packing = setup.bodies, setup.packing
+            self._body_volume = float(setup.packing.volumes.sum())
+            self._body_radii = np.asarray(setup.packing.radii, dtype=float)
+            reference_count = setup.reference_count
+        else:
             positions = lattice_positions(scene)
             velocities = initial_velocities(scene, positions)
-        else:
-            positions, velocities = _state["positions"], _state["velocities"]
         self.n_particles = int(positions.shape[0])
-        self._rho_eq = self.n_particles * self._mass / scene.volume
+        self._rho_eq = (reference_count or self.n_particles) * self._mass / scene.volume
+        self._lubrication = self._lubrication_setup()
+        self._shifting = float(scene.numerics.shifting)
         if _state is None:
             self.sound_speed = (float(scene.run.sound_speed) if scene.run.sound_speed is not None
                                 else auto_sound_speed(scene))
@@ -95,13 +129,24 @@ class Simulation:
         self.rebuild_count = 0
         self.rebuild_seconds = 0.0
         self._allocate(positions, velocities, capacity_factor=1.5)
+        if _state is None and self.bodies is not None:
+            self._body_of[:] = setup.body_of
+            self._offsets[:] = setup.offsets
         if _state is None:
             self._rebuild(0.0)
+            if scene.lattice.relax:
+                self.relax(scene.lattice.relax_tolerance, scene.lattice.relax_max_steps)
             self._compute_accelerations(self._v, self._a)
+            if self.bodies is not None:
+                self.bodies.set_forces(*self._body_forces())
         else:
             for name, attribute in _STATE_ARRAYS.items():
                 getattr(self, attribute)[...] = _state[name]
+            if self.bodies is not None:
+                self._body_virial[:] = _state["body_virial"]
+                self._lubrication_virial[:] = _state["lubrication_virial"]
             self._relist_from_reference()
+            self._members = np.flatnonzero(self._body_of >= 0)
         log.info("simulation: %d particles, dt = %.4g, c = %.4g, %d chunk(s) on %d thread(s)",
                  self.n_particles, self.dt, self.sound_speed, self._n_chunks, self.threads)
 
@@ -134,6 +179,13 @@ class Simulation:
         self._scratch_6 = np.zeros((t - 1, n * FORCE_WIDTH))
         self._bounds = np.zeros(t + 1, dtype=np.int64)
         self._virial = np.zeros((t, 5))
+        self._body_of = np.full(n, -1, dtype=np.int64)
+        self._offsets = np.zeros((n, 3))
+        self._members = np.zeros(0, dtype=np.int64)
+        self._grad_c = np.zeros((n, 3)) if self._shifting > 0.0 else np.zeros((0, 3))
+        self._body_virial = np.zeros(5)
+        self._lubrication_virial = np.zeros(5)
+        self._lubrication_stats = np.array([np.inf, 0.0, 0.0])
         self._allocate_list(capacity_factor)
 
     def _allocate_list(self, capacity_factor: float) -> None:
@@ -154,13 +206,16 @@ class Simulation:
             try:
                 rebuild_neighbour_list(self._nlist, self._x, self._v, self._box,
                                        self._offset(time), self._rate,
-                                       particle_arrays=(self._a,))
+                                       particle_arrays=(self._a, self._body_of, self._offsets))
                 break
             except NeighbourListOverflowError as err:
                 factor = 1.3 * err.required / err.capacity * self._capacity_factor
                 log.info("neighbour list overflow; capacity factor %.3g", factor)
                 self._allocate_list(factor)
         self._build_time = time
+        if self.bodies is not None:
+            self._members = np.flatnonzero(self._body_of >= 0)
+            self.bodies.wrap(self._box, self._offset(time), self._rate)
         self.rebuild_count += 1
         self.rebuild_seconds += time_module.perf_counter() - started
 
@@ -182,7 +237,8 @@ class Simulation:
                 self._mass, self._rho_eq, self.sound_speed ** 2, self._rate, self._body_force,
                 s.dimension, s.fluid.law.code, s.fluid.law.packed, self._newtonian,
                 self._velocity_gradient, self._normalise, self._alpha, self._beta,
-                self._bulk_factor, self._bulk_gradient, self._rho, self._volume,
+                self._bulk_factor, self._bulk_gradient, self.bodies is not None, self._body_of,
+                self._rho, self._volume,
                 self._pressure, tb.pair_end, tb.pair_j, tb.pair_geometry, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
                 self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
@@ -208,6 +264,9 @@ class Simulation:
     def advance(self, n_steps: int) -> None:
         """Run ``n_steps`` steps in compiled code; Python only rebuilds the neighbour list."""
         numba.set_num_threads(self.threads)
+        if self.bodies is not None or self._shifting > 0.0:
+            self._advance_python(int(n_steps))
+            return
         remaining, resume = int(n_steps), False
         nl = self._nlist
         while remaining > 0:
@@ -222,6 +281,147 @@ class Simulation:
             if rebuild:
                 self._rebuild((self.step_count + 1) * self.dt)
                 nl = self._nlist
+
+    @property
+    def n_body_particles(self) -> int:
+        """SPH particles in the bodies' shells (0 without inclusions)."""
+        return int(self._members.shape[0])
+
+    @property
+    def packing_phi(self) -> float:
+        """Solid volume fraction Σ V_b / V of the bodies (0 without inclusions)."""
+        return 0.0 if self.bodies is None else float(self._body_volume / self.scene.volume)
+
+    def _place_bodies(self, velocities, omegas, time: float, out) -> None:
+        """Body particles at their rigid positions; their velocities into ``out``."""
+        place_body_particles(self._members, self._body_of, self._offsets, self.bodies.centres,
+                             self.bodies.rotations(), velocities, omegas, self._box,
+                             self._offset(time), self._rate, self._x, out)
+
+    def _body_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """(F, T) of every body from the last force pass; updates the stress correction."""
+        b = self.bodies.count
+        forces, torques = np.zeros((b, 3)), np.zeros((b, 3))
+        body_force_torque(self._members, self._body_of, self._offsets, self.bodies.rotations(),
+                          self._force_acc, FORCE_WIDTH, forces, torques, self._body_virial)
+        return forces, torques
+
+    def _lubrication_setup(self):
+        """(s_c, s_min, C per body pair scale, scalar inertia) or None (``inclusions.lubrication``)."""
+        spec = self.scene.inclusions.lubrication
+        if self.bodies is None or not spec.enabled:
+            return None
+        rate = self._rate
+        scale = (spec.repulsion * float(self.scene.fluid.law.viscosity(rate)) * rate
+                 * spec.min_gap ** 8)
+        return spec.cutoff_gap, spec.min_gap, scale, self.bodies.moments.mean(axis=1)
+
+    def _lubricate(self, time: float) -> None:
+        """Implicit lubrication impulses on the kicked bodies (``bodies.lubrication_pass``)."""
+        bodies, law = self.bodies, self.scene.fluid.law
+        cutoff, min_gap, scale, inertia = self._lubrication
+        omegas = bodies.angular_velocities()
+        mean_radius2 = float(np.mean(self._body_radii)) ** 2
+        lubrication_pass(bodies.centres, self._body_radii, bodies.velocities, omegas,
+                         bodies.mass, inertia, self._box, self._offset(time), self._rate,
+                         self.dt, law.code, law.packed, cutoff, min_gap, scale * mean_radius2,
+                         self._lubrication_virial, self._lubrication_stats)
+        bodies.set_angular_velocities(omegas)
+
+    def _advance_python(self, n_steps: int) -> None:
+        """The step of :mod:`~suspsim.sph.integrator` with rigid bodies or shifting (module
+        docstrings of ``integrator``, ``bodies.system``, ``terms.shifting``): drift fluid and
+        bodies, place the body particles, rebuild if needed, predict, place with the predicted
+        body motion, forces, kick both, lubrication, shift."""
+        bodies, dt = self.bodies, self.dt
+        for _ in range(n_steps):
+            time = (self.step_count + 1) * self.dt
+            drift(self._x, self._v, self._a, dt)
+            if bodies is not None:
+                bodies.drift(dt)
+                self._place_bodies(bodies.velocities, bodies.angular_velocities(), time,
+                                   self._v)
+            nl = self._nlist
+            if needs_rebuild(self._x, self._reference, self._rate * (time - self._build_time),
+                             nl.cutoff, nl.skin, 0.5 * self._box[1]):
+                self._rebuild(time)
+            predict(self._v, self._a, dt, self._v_pred)
+            if bodies is not None:
+                self._place_bodies(*bodies.predicted(dt), time, self._v_pred)
+            box, *rest = self._physics_args()
+            accelerations(self._x, self._v_pred, box, self._offset(time), *rest, self._a_new)
+            kick(self._v, self._a, self._a_new, dt)
+            if bodies is not None:
+                bodies.kick(*self._body_forces(), dt)
+                if self._lubrication is not None:
+                    self._lubricate(time)
+                self._place_bodies(bodies.velocities, bodies.angular_velocities(), time,
+                                   self._v)
+            if self._shifting > 0.0:
+                tb = self._table
+                shift_particles(self._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
+                                self._volume, self._body_of, self._shifting, self._rate, dt,
+                                SUPPORT, self._gradient, self._grad_c, self._x, self._v)
+            self.step_count += 1
+
+    def relax(self, tolerance: float, max_steps: int) -> int:
+        """Relax the start; returns the steps taken (scene key ``lattice.relax``).
+
+        The fluid moves under its own pressure and viscous forces with the bodies held still,
+        no imposed flow and velocities damped by :data:`RELAX_DAMPING` per step, until the
+        density error is at most ``tolerance`` (checked every :data:`RELAX_CHECK` steps) or
+        ``max_steps`` have run. Then time restarts at 0 with the initial velocities of the
+        scene (imposed profile or rest) at the relaxed positions.
+        """
+        rate, self._rate = self._rate, 0.0
+        dt = self.dt
+        self._v[:] = 0.0
+        self._a[:] = 0.0
+        still = np.zeros((self.bodies.count if self.bodies is not None else 0, 3))
+        error, steps = self._density_error(), 0
+        while error > tolerance and steps < max_steps:
+            drift(self._x, self._v, self._a, dt)
+            if self.bodies is not None:
+                self._place_bodies(still, still, 0.0, self._v)
+            nl = self._nlist
+            if needs_rebuild(self._x, self._reference, 0.0, nl.cutoff, nl.skin):
+                self._rebuild(0.0)
+            predict(self._v, self._a, dt, self._v_pred)
+            if self.bodies is not None:
+                self._place_bodies(still, still, 0.0, self._v_pred)
+            self._compute_accelerations(self._v_pred, self._a_new)
+            kick(self._v, self._a, self._a_new, dt)
+            self._v *= 1.0 - RELAX_DAMPING
+            if self.bodies is not None:
+                self._place_bodies(still, still, 0.0, self._v)
+            steps += 1
+            if steps % RELAX_CHECK == 0:
+                error = self._density_error()
+        error = self._density_error()
+        self._rate = rate
+        self._start_flow()
+        log.info("relaxed the start in %d steps: density error %.3g (tolerance %.3g)", steps,
+                 error, tolerance)
+        if error > tolerance:
+            log.warning("the start is still %.3g from rho_eq after lattice.relax_max_steps = %d "
+                        "steps (lattice.relax_tolerance %.3g)", error, max_steps, tolerance)
+        return steps
+
+    def _start_flow(self) -> None:
+        """Velocities of the scene's start at the current positions; list rebuilt at time 0."""
+        self._rebuild(0.0)
+        fluid = self._body_of < 0
+        self._v[fluid] = initial_velocities(self.scene, self._x[fluid])
+        self._a[:] = 0.0
+        if self.bodies is not None:
+            moving = self.scene.flow.type == "couette" and self.scene.run.start == "linear"
+            omegas = np.zeros((self.bodies.count, 3))
+            velocities = np.zeros((self.bodies.count, 3))
+            if moving:
+                velocities[:, 0] = imposed_velocity(self.scene, self.bodies.centres[:, 1])
+                omegas[:, 2] = -0.5 * self._rate
+            self.bodies.set_motion(velocities, omegas)
+            self._place_bodies(velocities, omegas, 0.0, self._v)
 
     def memory_bytes(self) -> int:
         """Bytes held by the particle arrays, the neighbour list, the pair table and scratch."""
@@ -238,7 +438,9 @@ class Simulation:
         return out
 
     def _density_error(self) -> float:
-        return float(np.max(np.abs(self._rho / self._rho_eq - 1.0)))
+        """max |ρ/ρ_eq − 1| over the fluid particles (a rigid body's particles cannot follow)."""
+        rho = self._rho if self.bodies is None else self._rho[self._body_of < 0]
+        return float(np.max(np.abs(rho / self._rho_eq - 1.0)))
 
     def _mach(self) -> float:
         peculiar = self._peculiar()
@@ -259,6 +461,11 @@ class Simulation:
             return False, (f"density error {error:.3g} exceeds run.max_density_error "
                            f"{run.max_density_error:g} {where}: raise run.sound_speed or lower "
                            f"run.dt ({settings})")
+        if self._lubrication is not None and (self._lubrication_stats[OVERLAPS] > 0
+                                              or self._lubrication_stats[SMALLEST_GAP] < 0):
+            return False, (f"bodies overlap {where} (smallest gap "
+                           f"{self._lubrication_stats[SMALLEST_GAP]:.3g} h): raise "
+                           f"inclusions.lubrication.repulsion or lower run.dt ({settings})")
         mach = self._mach()
         if mach > run.max_mach:
             return False, (f"Mach number {mach:.3g} exceeds run.max_mach {run.max_mach:g} "
@@ -269,7 +476,9 @@ class Simulation:
         """Instantaneous scalars: shear_stress σ_xy, pressure tr Π/d, kinetic_energy of ṽ,
         density_error, mach (SPEC §2.8)."""
         peculiar = self._peculiar()
-        pi = pressure_tensor(self._virial, peculiar, self._mass, self.scene.volume)
+        rows = self._virial if self.bodies is None else np.vstack(
+            [self._virial, self._body_virial, self._lubrication_virial])
+        pi = pressure_tensor(rows, peculiar, self._mass, self.scene.volume)
         return {"shear_stress": shear_stress(pi),
                 "pressure": mean_pressure(pi, self.scene.dimension),
                 "kinetic_energy": 0.5 * self._mass * float(np.sum(peculiar * peculiar)),
@@ -298,6 +507,12 @@ class Simulation:
         out.update(time=self.time, step_count=self.step_count, dt=self.dt,
                    sound_speed=self.sound_speed, build_time=self._build_time,
                    n_chunks=self._n_chunks)
+        if self.bodies is not None:
+            out.update(bodies=self.bodies.state(), body_volume=self._body_volume,
+                       body_radii=self._body_radii.copy(),
+                       lubrication_virial=self._lubrication_virial.copy(),
+                       reference_count=round(self._rho_eq * self.scene.volume / self._mass),
+                       body_virial=self._body_virial.copy())
         return out
 
     @classmethod

@@ -123,7 +123,7 @@ def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction
             "run": {"strain": resolution.strain, "transient": resolution.transient,
                     "start": "linear", "threads": "all" if threads is None else int(threads)},
             "lattice": {"jitter": resolution.jitter},
-            "inclusions": {"volume_fraction": float(volume_fraction)},
+            "inclusions": {"phi": float(volume_fraction)},
             "seed": int(seed)}
     return scene_from_dict(data, source="simulation resolution"), mapping
 

@@ -7,7 +7,9 @@ Lees–Edwards correction v_x −= n γ̇ L_y):
     f_ij = m² (P_i/ρ_i² + P_j/ρ_j²) F r                         (``pressure``, SPEC §2.2)
          − (μ̂_i + μ̂_j) m² F/(ρ_i ρ_j) [α (r·v) r/r² + β v]      (``viscous``, SPEC §2.3–2.4)
 
-with m² F/(ρ_i ρ_j) = F V_i V_j from the step's volumes V = m/ρ, added to i and subtracted from j (antisymmetric: momentum conserved to round-off). With the
+with m² F/(ρ_i ρ_j) = F V_i V_j from the step's volumes V = m/ρ, added to i and subtracted from j (antisymmetric: momentum conserved to round-off).
+Pairs of two particles of one rigid body (``body_of[i] == body_of[j] ≥ 0``) are skipped: their
+forces are internal to the body, and the β term of a rotating body would give a spurious torque. With the
 bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
 ∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
 explicit term ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k is added per particle afterwards; it has no pair
@@ -40,7 +42,7 @@ VXX, VYY, VZZ, VXY, VYX = range(5)
 
 @njit(inline="always", **JIT_OPTIONS)
 def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure, viscosity,
-                alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc, virial_row):
+                alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of, acc, virial_row):
     """acc[6 i ...] += forces (and ∇a sums) of particles lo..hi−1, both ends; virial_row +=."""
     sxx = syy = szz = sxy = syx = 0.0
     for i in range(lo, hi):
@@ -48,11 +50,14 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pre
         mu_i = viscosity[i]
         a_i = bulk_factor * mu_i
         vol_i = volume[i]
+        body_i = body_of[i]
         vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
         fxi = fyi = fzi = 0.0
         gxi = gyi = gzi = 0.0
         for k in range(start[i], pair_end[i]):
             j = pair_j[k]
+            if body_i >= 0 and body_of[j] == body_i:
+                continue
             row = geometry[k]
             dx, dy, dz, f = row[0], row[1], row[2], row[3]
             r2 = dx * dx + dy * dy + dz * dz
@@ -104,10 +109,11 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pre
 
 @njit(parallel=True, **JIT_OPTIONS)
 def force_sums(start, pair_end, pair_j, geometry, velocity, rho, volume, viscosity, mass, rho_eq,
-               c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, pressure, acc, scratch,
-               bounds, virial):
+               c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of, pressure, acc,
+               scratch, bounds, virial):
     """acc (6 N,) = pair forces and ∇a sums of every particle; virial (T, 5) per chunk;
-    ``pressure`` (N,) scratch for the particles' m² P/ρ²."""
+    ``pressure`` (N,) scratch for the particles' m² P/ρ²; ``body_of`` (N,) the rigid body of
+    each particle, −1 for fluid."""
     for i in prange(rho.shape[0]):
         pressure[i] = pressure_term(rho[i], rho_eq, c2, mass)
     n_chunks = scratch.shape[0] + 1
@@ -117,14 +123,14 @@ def force_sums(start, pair_end, pair_j, geometry, velocity, rho, volume, viscosi
         if c == 0:
             acc[:] = 0.0
             _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure,
-                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, acc,
-                        virial[0])
+                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of,
+                        acc, virial[0])
         else:
             buffer = scratch[c - 1]
             buffer[FORCE_WIDTH * lo:] = 0.0
             _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure,
-                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, buffer,
-                        virial[c])
+                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of,
+                        buffer, virial[c])
     add_chunk_buffers(acc, scratch, bounds, n_chunks, FORCE_WIDTH)
 
 
