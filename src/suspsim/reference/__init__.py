@@ -6,6 +6,7 @@
   periodic set-up of SPEC §2.7 and the channel Bingham number (SPEC §6.2).
 * :mod:`~suspsim.reference.couette_startup` — start-up of Couette flow from rest (the
   Lees–Edwards box of seed 000 Fig. 1): 1D finite volumes for any law, Newtonian series.
+* :mod:`~suspsim.reference.dst_channel` — steady local Wyart–Cates channel flow (SPEC §5.7).
 """
 from suspsim.reference.couette_startup import couette_startup, newtonian_couette_startup
 from suspsim.reference.poiseuille import (bingham_number, force_density_for_bingham,

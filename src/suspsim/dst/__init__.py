@@ -1,0 +1,21 @@
+"""2D wall-bounded SPH for discontinuous shear thickening (seed 002; SPEC §1.3, §5).
+
+A solver separate from the periodic Lees–Edwards one of :mod:`suspsim.sph`: Morris viscous
+operator, Tait EOS with background pressure, Adami dummy-particle walls, predictor–corrector,
+and a Wyart–Cates microstructure f per particle.
+
+- :mod:`~suspsim.dst.parameters`: fluid (``eta_s, phi, phi_m, phi_0, sigma_star, beta, K_f,
+  alpha``), geometry, flows (:class:`StressCouette`, :class:`Channel`), numerics;
+- :mod:`~suspsim.dst.terms`: one compiled function per equation (EOS, continuity, pressure,
+  Morris viscous, Laplacian, γ̇, Maron–Pierce viscosity, microstructure rate);
+- :mod:`~suspsim.dst.neighbours`: full CSR list, x periodic, y bounded;
+- :mod:`~suspsim.dst.passes`: wall pass (Adami 2012) and fluid pass;
+- :mod:`~suspsim.dst.integrator`: rate evaluation, step size, predictor–corrector, shifting;
+- :mod:`~suspsim.dst.simulation`: :class:`DSTSimulation` (advance, sample, profiles,
+  snapshot, branch statistics).
+"""
+from suspsim.dst.parameters import Channel, Geometry, Numerics, StressCouette, WyartCatesFluid
+from suspsim.dst.simulation import DSTSimulation
+
+__all__ = ["Channel", "DSTSimulation", "Geometry", "Numerics", "StressCouette",
+           "WyartCatesFluid"]
