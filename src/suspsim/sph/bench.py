@@ -2,10 +2,13 @@
 
 The issue's performance scene: a 3D periodic Lees–Edwards Couette box of side 20 h at number
 density 4.096 per h³ (32³ = 32,768 particles, jittered simple-cubic lattice), Lucy kernel,
-default numerics (bulk correction and dissipation normalisation on). Two fluids:
+default numerics (bulk correction and dissipation normalisation on). Scenes:
 
 - ``fluid-newtonian``: μ = 1, γ̇ = 0.0244 (particle Reynolds number ρ γ̇ h²/μ = 0.1);
-- ``fluid-papanastasiou``: μ_pl = 0.01, μ_0 = 0.99, M = 100 (seed 000: μ_0/μ_pl = 99), γ̇ = 0.01.
+- ``fluid-papanastasiou``: μ_pl = 0.01, μ_0 = 0.99, M = 100 (seed 000: μ_0/μ_pl = 99), γ̇ = 0.01;
+- ``suspension-newtonian``: the Newtonian fluid with spheres of radius 2.5 h at φ = 0.4 (the
+  bodies' shell particles count as particles; the start's relaxation is cut to 100 steps, a
+  benchmark measures cost, not physics).
 
 :func:`benchmark` times ``n_steps`` steps after :data:`WARM_UP` untimed steps and
 reports particle-steps per second (N × steps / wall time), neighbour-list rebuilds included,
@@ -32,23 +35,26 @@ WARM_UP = 50
 SAMPLES = 20
 #: Scenes of :func:`benchmark` (fluid and shear rate; the box is common).
 SCENES = {
-    "fluid-newtonian": ({"law": "newtonian", "params": {"mu": 1.0}}, 0.0244),
+    "fluid-newtonian": ({"law": "newtonian", "params": {"mu": 1.0}}, 0.0244, {}),
     "fluid-papanastasiou": ({"law": "papanastasiou",
-                             "params": {"mu_pl": 0.01, "mu_0": 0.99, "M": 100.0}}, 0.01),
+                             "params": {"mu_pl": 0.01, "mu_0": 0.99, "M": 100.0}}, 0.01, {}),
+    "suspension-newtonian": ({"law": "newtonian", "params": {"mu": 1.0}}, 0.0244,
+                             {"phi": 0.4, "radius": 2.5}),
 }
 
 
 def benchmark_scene(scene_name: str):
     """The validated scene of ``scene_name`` (see :data:`SCENES`)."""
     try:
-        fluid, rate = SCENES[scene_name]
+        fluid, rate, inclusions = SCENES[scene_name]
     except KeyError:
         raise ValueError(f"unknown benchmark scene {scene_name!r}; known: "
                          f"{', '.join(SCENES)}") from None
     return scene_from_dict({
         "dimension": 3, "box": [20.0, 20.0, 20.0], "number_density": 4.096, "kernel": "lucy",
         "fluid": fluid, "flow": {"type": "couette", "shear_rate": rate},
-        "run": {"strain": 1.0, "start": "linear"}, "lattice": {"jitter": 0.1}, "seed": 1})
+        "run": {"strain": 1.0, "start": "linear"}, "inclusions": inclusions,
+        "lattice": {"jitter": 0.0 if inclusions else 0.1, "relax_max_steps": 100}, "seed": 1})
 
 
 def benchmark(scene_name: str, n_steps: int, threads: int) -> dict:
