@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "unit" / "sph"))
-from sph_helpers import couette_scene  # noqa: E402
+from sph_helpers import couette_scene, measured_viscosity_ratio  # noqa: E402
 
 from suspsim.reference.poiseuille import (force_density_for_bingham,  # noqa: E402
                                           poiseuille_profile, split_force_poiseuille_profile)
@@ -48,22 +48,6 @@ def papanastasiou_params(rate, density=DENSITY_3D, M=100.0):
 
 def couette_side(dim):
     return (5.0 if REDUCED else 7.5) if dim == 3 else (6.0 if REDUCED else 10.0)
-
-
-def measured_viscosity_ratio(scene, transient=1, units=3):
-    """σ_xy/(μ(γ̇) γ̇) averaged over ``units`` whole strain units after ``transient``."""
-    sim = Simulation(scene, threads=THREADS)
-    rate = scene.flow.shear_rate
-    per_unit = int(round(1.0 / (rate * sim.dt)))
-    sim.advance(transient * per_unit)
-    stride = max(1, per_unit // 50)
-    stresses = []
-    for _ in range(units * per_unit // stride):
-        sim.advance(stride)
-        stresses.append(sim.sample()["shear_stress"])
-    ok, message = sim.health()
-    assert ok, message
-    return np.mean(stresses) / (float(scene.fluid.law.viscosity(rate)) * rate), sim
 
 
 @pytest.mark.parametrize("dim", [3, 2])

@@ -32,6 +32,14 @@ from suspsim.sph import JIT_OPTIONS
 VXX, VYY, VZZ, VXY, VYX = range(5)
 
 
+@njit(inline="always", **JIT_OPTIONS)
+def _arm(q, o):
+    """Q s⁰: the box-frame arm of a particle with body-frame offset ``o`` (3,), rotation ``q``."""
+    return (q[0, 0] * o[0] + q[0, 1] * o[1] + q[0, 2] * o[2],
+            q[1, 0] * o[0] + q[1, 1] * o[1] + q[1, 2] * o[2],
+            q[2, 0] * o[0] + q[2, 1] * o[1] + q[2, 2] * o[2])
+
+
 @njit(**JIT_OPTIONS)
 def place_body_particles(members, body_of, offsets, centres, rotations, velocities, omegas,
                          box, le_offset, shear_rate, positions, particle_velocities):
@@ -41,11 +49,7 @@ def place_body_particles(members, body_of, offsets, centres, rotations, velociti
     for k in range(members.shape[0]):
         i = members[k]
         b = body_of[i]
-        q = rotations[b]
-        o = offsets[i]
-        sx = q[0, 0] * o[0] + q[0, 1] * o[1] + q[0, 2] * o[2]
-        sy = q[1, 0] * o[0] + q[1, 1] * o[1] + q[1, 2] * o[2]
-        sz = q[2, 0] * o[0] + q[2, 1] * o[1] + q[2, 2] * o[2]
+        sx, sy, sz = _arm(rotations[b], offsets[i])
         x = centres[b, 0] + sx
         y = centres[b, 1] + sy
         z = centres[b, 2] + sz
@@ -74,11 +78,7 @@ def body_force_torque(members, body_of, offsets, rotations, force_acc, width, fo
     for k in range(members.shape[0]):
         i = members[k]
         b = body_of[i]
-        q = rotations[b]
-        o = offsets[i]
-        sx = q[0, 0] * o[0] + q[0, 1] * o[1] + q[0, 2] * o[2]
-        sy = q[1, 0] * o[0] + q[1, 1] * o[1] + q[1, 2] * o[2]
-        sz = q[2, 0] * o[0] + q[2, 1] * o[1] + q[2, 2] * o[2]
+        sx, sy, sz = _arm(rotations[b], offsets[i])
         fx = force_acc[width * i]
         fy = force_acc[width * i + 1]
         fz = force_acc[width * i + 2]

@@ -48,3 +48,20 @@ def interior(sim, xi, margin=1.25):
     half = 0.5 * np.array(sim.scene.box)
     d = sim.scene.dimension
     return np.all(np.abs(xi[:, :d]) < half - margin, axis=1)
+
+
+def measured_viscosity_ratio(scene, transient=1, units=3, threads=2):
+    """(σ_xy/(μ(γ̇) γ̇) averaged over ``units`` whole strain units after ``transient``, the
+    simulation); asserts the run stayed healthy. Two threads: CI's cores."""
+    sim = Simulation(scene, threads=threads)
+    rate = scene.flow.shear_rate
+    per_unit = int(round(1.0 / (rate * sim.dt)))
+    sim.advance(transient * per_unit)
+    stride = max(1, per_unit // 50)
+    stresses = []
+    for _ in range(units * per_unit // stride):
+        sim.advance(stride)
+        stresses.append(sim.sample()["shear_stress"])
+    ok, message = sim.health()
+    assert ok, message
+    return np.mean(stresses) / (float(scene.fluid.law.viscosity(rate)) * rate), sim
