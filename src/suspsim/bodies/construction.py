@@ -74,6 +74,7 @@ from suspsim.sph import JIT_OPTIONS
 from . import harmonics as sh
 from .overlap import fibonacci_directions
 from .packing import Packing
+from .pairs import bin_by_cell
 from .radius_table import build_table, table_error, table_radius
 from .rotations import rotation_matrices
 
@@ -346,26 +347,7 @@ def fluid_outside_bodies(positions: np.ndarray, packing: Packing, box=None,
 def _clear_bodies(x, box, cells, centres, to_body, reach, radii, coefficients, alpha,
                   beta, grains, margin, keep):
     """Set keep[i] = False for points inside a body (see :func:`fluid_outside_bodies`)."""
-    n = x.shape[0]
-    n_cells = cells[0] * cells[1] * cells[2]
-    cell_of = np.empty(n, np.int64)
-    for i in range(n):
-        index = 0
-        for d in range(3):
-            f = x[i, d] / box[d]
-            f -= math.floor(f)
-            index = index * cells[d] + min(int(f * cells[d]), cells[d] - 1)
-        cell_of[i] = index
-    start = np.zeros(n_cells + 1, np.int64)
-    for i in range(n):
-        start[cell_of[i] + 1] += 1
-    for c in range(n_cells):
-        start[c + 1] += start[c]
-    fill = start[:-1].copy()
-    members = np.empty(n, np.int64)
-    for i in range(n):
-        members[fill[cell_of[i]]] = i
-        fill[cell_of[i]] += 1
+    _, start, members = bin_by_cell(x, box, cells)
     degree = alpha.shape[0] - 1
     low = np.empty(3, np.int64)
     span = np.empty(3, np.int64)

@@ -30,26 +30,18 @@ def minimum_image(dx, dy, dz, lx, ly, lz):
 
 
 @njit(cache=True)
-def build_pairs(positions, reach, box, skin, pairs):
-    """Fill ``pairs`` with (i, j), i < j, of minimum-image distance < reach_i + reach_j + skin.
-
-    Returns the number of pairs found (may exceed ``len(pairs)``: overflow, see module doc).
-    """
+def bin_by_cell(positions, box, cells):
+    """(cell_of, start, members): each point's cell of a ``cells`` (3,) grid over the periodic
+    ``box`` (wrapped), and the points of cell c as members[start[c]:start[c + 1]]."""
     n = positions.shape[0]
-    width = 2.0 * reach.max() + skin
-    cells = np.empty(3, np.int64)
-    for d in range(3):
-        c = int(math.floor(box[d] / width))
-        cells[d] = c if c >= 3 else 1
     n_cells = cells[0] * cells[1] * cells[2]
-    spread = np.minimum(cells - 1, 1)
     cell_of = np.empty(n, np.int64)
     for i in range(n):
         index = 0
         for d in range(3):
-            x = positions[i, d] - box[d] * math.floor(positions[i, d] / box[d])
-            c = min(int(x / box[d] * cells[d]), cells[d] - 1)
-            index = index * cells[d] + c
+            f = positions[i, d] / box[d]
+            f -= math.floor(f)
+            index = index * cells[d] + min(int(f * cells[d]), cells[d] - 1)
         cell_of[i] = index
     start = np.zeros(n_cells + 1, np.int64)
     for i in range(n):
@@ -61,6 +53,23 @@ def build_pairs(positions, reach, box, skin, pairs):
     for i in range(n):
         members[fill[cell_of[i]]] = i
         fill[cell_of[i]] += 1
+    return cell_of, start, members
+
+
+@njit(cache=True)
+def build_pairs(positions, reach, box, skin, pairs):
+    """Fill ``pairs`` with (i, j), i < j, of minimum-image distance < reach_i + reach_j + skin.
+
+    Returns the number of pairs found (may exceed ``len(pairs)``: overflow, see module doc).
+    """
+    n = positions.shape[0]
+    width = 2.0 * reach.max() + skin
+    cells = np.empty(3, np.int64)
+    for d in range(3):
+        c = int(math.floor(box[d] / width))
+        cells[d] = c if c >= 3 else 1
+    spread = np.minimum(cells - 1, 1)
+    cell_of, start, members = bin_by_cell(positions, box, cells)
     capacity = pairs.shape[0]
     count = 0
     lx, ly, lz = box[0], box[1], box[2]
