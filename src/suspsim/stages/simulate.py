@@ -17,8 +17,8 @@ The run starts from the linear profile (``run.start = linear``): the step is the
 μ(γ̇/2) rather than the zero-rate viscosity (:mod:`suspsim.sph.timestep`), which for a
 yield-stress matrix is many orders of magnitude cheaper.
 
-Rigid inclusions (φ > 0) are not available yet: :func:`simulation_scene` raises
-:class:`InclusionsNotAvailable`.
+Rigid inclusions (φ > 0) run in the solver but are not validated yet (README, Suspensions):
+:func:`simulation_scene` raises :class:`InclusionsNotAvailable`.
 """
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ SIMULATION_SUFFIX = ".sim.nc"
 
 
 class InclusionsNotAvailable(SuspsimError, NotImplementedError):
-    """φ > 0 asks for rigid inclusions, which the solver does not build yet."""
+    """φ > 0: the solver builds rigid inclusions, but their viscosity is not validated yet."""
 
 
 @dataclass(frozen=True)
@@ -110,9 +110,9 @@ def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction
         raise InputError("simulation", f"volume fraction {volume_fraction!r} must be in [0, 1)")
     if volume_fraction > 0:
         raise InclusionsNotAvailable(
-            f"volume fraction {volume_fraction:g} needs rigid inclusions (packings and rigid "
-            "bodies in the SPH solver, SPEC §3), which are not available yet; simulate phi = 0 "
-            "only for now")
+            f"volume fraction {volume_fraction:g}: the solver runs rigid inclusions (scene key "
+            "'inclusions'), but their suspension viscosity is not validated yet (the Einstein "
+            "limit fails, see the README), so the workflow simulates phi = 0 only for now")
     mapping = unit_mapping(law, shear_rate, density=resolution.number_density,
                            reynolds_number=resolution.reynolds)
     sim_law = mapping.law_to_simulation(law)
