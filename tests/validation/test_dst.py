@@ -13,8 +13,8 @@ Scaled units [choice, SPEC §7]: length L_y (the gap) = 1, viscosity η_s = 1, s
 * Newtonian channel/Couette: ρ = 1 and 0.1 (Re = ρ U L_y/η ≤ 0.13).
 * DST flow curve (stress control): the homogeneous state on the unstable branch is stable only
   while momentum (time ρ L_y²/η) follows the microstructure (time 1/(K_f γ̇)); we take the
-  largest density with ε = K_f γ̇ ρ L_y²/η = 0.05, i.e. ρ = 0.05 σ/(K_f γ̇²): one strain unit
-  then costs (L_y/h_sl)²/(0.125 ε) steps, whatever σ is.
+  density with ε = K_f γ̇ ρ L_y²/η = 0.1, i.e. ρ = 0.1 σ/(K_f γ̇²): one strain unit then costs
+  (L_y/h_sl)²/(0.3 ε) steps, whatever σ is (the set-up is :func:`suspsim.dst.study.flow_curve`).
 * DST channel: ρ = 1 (ε ≤ 0.01): the velocity settles in ≈ 0.03 time units.
 
 The sound speed follows the Morris criteria (c ≥ 10 V, c² ≥ σ/(ρ δ), c² ≥ g L_y/δ with
@@ -30,6 +30,7 @@ import pytest
 
 from suspsim.dst import (Channel, DSTSimulation, Geometry, Numerics, StressCouette,
                          WyartCatesFluid)
+from suspsim.dst.study import STRONG_NONLOCALITY, flow_curve
 from suspsim.reference.dst_channel import dst_channel_mean_velocity, dst_channel_profile
 
 pytestmark = pytest.mark.slow
@@ -166,30 +167,28 @@ def test_strong_nonlocality_flow_curve_point(phi, stress):
     """α = 0.02 (seed 002's 1e−5 m²/s scaled), stress control: domain-averaged (γ̇, σ) within
     5 % of the Wyart–Cates curve, on the unstable branch as well.
 
-    Starts at the fixed point of SPEC §5.4 (f = f̂(σ_in), V_w = γ̇(σ_in) L_y) and averages
-    samples over strains 1.5–3 (γ̇ t): an unstable homogeneous state would have drifted by
-    then (perturbations grow like e^(K_f γ̇ t · slope)). Density from ε = 0.1, so Re = 0.1.
+    The run is :func:`suspsim.dst.study.flow_curve` (its docstring gives the set-up): it starts
+    at the fixed point of SPEC §5.4 (f = f̂(σ_in), V_w = γ̇(σ_in) L_y) and averages samples over
+    strains 1.5–3 (γ̇ t): an unstable homogeneous state would have drifted by then
+    (perturbations grow like e^(K_f γ̇ t · slope)). Density from ε = 0.1, so Re = 0.1.
     """
     n_y = 12 if REDUCED else 20
-    fluid = WyartCatesFluid(**{**SEED_054, "phi": phi}, alpha=0.02)
-    law = fluid.steady_law()
-    rate = float(law.shear_rate(stress))
-    epsilon = 0.1
-    rho = epsilon * stress / (fluid.K_f * rate ** 2)
-    sim = DSTSimulation(fluid, StressCouette(stress), Geometry(N_X, n_y, 1.0),
-                        Numerics(density=rho), threads=THREADS)
-    total = int(math.ceil(3.0 / rate / sim.dt))
-    _run(sim, total // 2, f"DST flow curve phi={phi} sigma={stress:g} n_y={n_y}")
-    samples = []
-    for _ in range(10):
-        sim.advance(total // 20)
-        samples.append(sim.sample())
-    gdot = np.mean([s["shear_rate"] for s in samples])
-    sigma = np.mean([s["stress"] for s in samples])
-    wall_rate = np.mean([s["wall_shear_rate"] for s in samples])
-    print(f"  <gdot>/gdot_WC {gdot / rate:.4f}, V_w/L_y/gdot_WC {wall_rate / rate:.4f}, "
-          f"<sigma>/sigma_in {sigma / stress:.4f}, f {samples[-1]['fraction']:.4f} "
-          f"(f_hat {fluid.frictional_fraction(stress):.4f})")
+    point = flow_curve(phi, [stress], alpha=STRONG_NONLOCALITY, lattice=(N_X, n_y),
+                       threads=THREADS).isel(stress=0)
+    law = WyartCatesFluid(**{**SEED_054, "phi": phi}).steady_law()
+    rate = float(point["wyart_cates_shear_rate"])
+    gdot, sigma = float(point["shear_rate"]), float(point["measured_stress"])
+    wall_rate = float(point["wall_shear_rate"])
+    steps, wall = int(point["steps"]), float(point["wall_time"])
+    particles = point.attrs["n_particles"]
+    print(f"\n[DST flow curve phi={phi} sigma={stress:g} n_y={n_y}] {particles} particles, "
+          f"{steps} steps (dt {float(point['time_step']):.3g}), wall {wall:.1f} s, "
+          f"{particles * steps / wall:.3g} particle-steps/s")
+    print(f"  <gdot>/gdot_WC {gdot / rate:.4f} +- {float(point['shear_rate_stderr']) / rate:.1e}"
+          f", V_w/L_y/gdot_WC {wall_rate / rate:.4f}, <sigma>/sigma_in {sigma / stress:.4f}, "
+          f"f {float(point['frictional_fraction']):.4f} "
+          f"(f_hat {float(point['steady_frictional_fraction']):.4f})")
+    assert rate == pytest.approx(float(law.shear_rate(stress)), rel=1e-12)
     assert gdot == pytest.approx(rate, rel=0.05)
     assert wall_rate == pytest.approx(rate, rel=0.05)
     assert sigma == pytest.approx(stress, rel=0.05)

@@ -1,0 +1,287 @@
+"""Stress-controlled DST flow curves: one :class:`DSTSimulation` per imposed stress (issue 5).
+
+:func:`flow_curve` is the set-up and equilibration of the validation test
+(``tests/validation/test_dst.py``, which calls it) as a pure function returning an
+:class:`xarray.Dataset` on the dimension ``stress``; :func:`flow_curve_dataset` builds that
+Dataset from per-point records (so plots can be tested on synthetic data) and
+:func:`spanning_stresses` gives a grid that crosses both turning points.
+
+Scaled units [choice, SPEC §7]: length L_y (the gap) = 1, viscosity η_s = 1, stress σ* = 1, so
+time is counted in η_s/σ* and rates in σ*/η_s (0.2 s and 5 /s for seed 002). Seed 002's
+α = 1e−5 m²/s (strong non-locality) becomes α η_s/(σ* L_y²) = 0.02, its 1e−8 m²/s
+(moderate) 2e−5. Variables carry ``units = "1"`` and their dimension in ``simulation_units``
+(``sigma_star``, ``eta_s``, ``L_y``), as in :mod:`suspsim.io.variables`.
+
+One point (SPEC §5.4):
+
+1. fluid ``WyartCatesFluid(1, φ, φ_m, φ_0, 1, β, K_f, α)``, flow ``StressCouette(σ_in)``,
+   geometry ``Geometry(n_x, n_y, 1)``, start at the fixed point f = f̂(σ_in), V_w = γ̇_WC L_y;
+2. density ρ = ε σ_in/(K_f γ̇_WC²), i.e. ε = K_f γ̇ ρ L_y²/η (momentum time over
+   microstructure time) = 0.1 by default: momentum follows the microstructure, so the
+   homogeneous state on the unstable branch stays homogeneous; Re = ρ γ̇ L_y²/η = ε/K_f. All
+   steady states are independent of ρ (Stokes flow); the Morris sound speed (δ = 1 %);
+3. equilibrate for ``equilibration_strain`` (γ̇_WC t, default 1.5), then take ``samples``
+   equally spaced samples over the next ``averaging_strain`` (default 1.5) — an unstable
+   homogeneous state would have drifted by then (perturbations grow like
+   e^(K_f γ̇ t · |S|), S = d ln γ̇/d ln σ);
+4. report the means of the domain averages ⟨γ̇⟩, ⟨σ⟩ = ⟨η γ̇⟩, V_w/L_y and ⟨f⟩ over the
+   samples, with batch-means standard errors (``n_blocks`` consecutive blocks,
+   :func:`suspsim.analysis.blocking.batch_means`). The simulation has no error estimate of its
+   own. The blocks are ≈ 0.19 strain long, shorter than the microstructure relaxation
+   1/(K_f γ̇) = 1 strain, so the error is the sampling scatter of this window; it does not
+   measure a slow drift or the bias of the finite lattice.
+
+The number of steps is set from the step size at the start (strain / (γ̇_WC δt)); with the
+viscous step limit δt = 0.3 ρ h_sl²/η it is ≈ (L_y/h_sl)²/(0.3 ε) per strain unit whatever
+σ_in is (≈ 11 000 at n_y = 20, ε = 0.1).
+"""
+from __future__ import annotations
+
+import json
+import logging
+import math
+import shlex
+import sys
+import time as wallclock
+from datetime import datetime, timezone
+
+import numpy as np
+import xarray as xr
+
+from suspsim.analysis.blocking import batch_means
+from suspsim.dst.parameters import Geometry, Numerics, StressCouette, WyartCatesFluid
+from suspsim.dst.simulation import DSTSimulation
+from suspsim.errors import InputError
+from suspsim.io.provenance import provenance
+
+log = logging.getLogger(__name__)
+
+#: Seed 002's jamming fractions and onset sharpness; K_f = 1 [SPEC §1.3 choice].
+SEED_002 = {"phi_m": 0.562, "phi_0": 0.693, "beta": 2.0, "K_f": 1.0}
+#: Seed 002's non-localities α [m²/s] scaled by σ* L_y²/η_s (σ* = 0.005 Pa, L_y = 0.01 m).
+STRONG_NONLOCALITY, MODERATE_NONLOCALITY, LOCAL = 0.02, 2e-5, 0.0
+
+UNIT_SYSTEM = ("scaled units: length L_y (wall-to-wall gap) = 1, viscosity eta_s (solvent) = 1, "
+               "stress sigma* (onset stress) = 1; time eta_s/sigma*, rate sigma*/eta_s; "
+               "variables have units '1' and state their dimension in simulation_units")
+REFERENCES = (
+    "Wyart & Cates, Phys. Rev. Lett. 112, 098302 (2014) (steady law); "
+    "seed 002 (2D SPH of DST with microstructure Df/Dt = K_f gdot (f_hat - f) + alpha lap f); "
+    "Morris, Fox & Zhu, J. Comput. Phys. 136, 214 (1997) (SPH viscous operator, step); "
+    "Adami, Hu & Adams, J. Comput. Phys. 231, 7057 (2012) (walls)")
+
+_RATE = "sigma_star eta_s-1"
+_STRESS = "sigma_star"
+
+#: name -> (long_name, simulation_units or None, comment or None); every output variable.
+FLOW_CURVE_VARIABLES = {
+    "stress": ("imposed shear stress sigma_in on the top wall", _STRESS, None),
+    "shear_rate": ("domain- and time-averaged shear-rate magnitude <sqrt(2 D:D)>", _RATE,
+                   "mean over the samples of the fluid-particle average"),
+    "shear_rate_stderr": ("standard error of shear_rate (batch means of the samples)", _RATE,
+                          None),
+    "wall_shear_rate": ("time-averaged top-wall velocity over the gap V_w/L_y", _RATE, None),
+    "wall_shear_rate_stderr": ("standard error of wall_shear_rate (batch means)", _RATE, None),
+    "measured_stress": ("domain- and time-averaged shear stress <eta gdot>", _STRESS, None),
+    "measured_stress_stderr": ("standard error of measured_stress (batch means)", _STRESS, None),
+    "frictional_fraction": ("domain- and time-averaged fraction of frictional contacts <f>",
+                            None, None),
+    "steady_frictional_fraction": ("steady fraction f_hat(sigma_in) = exp(-(sigma*/sigma_in)^"
+                                   "beta)", None, None),
+    "wyart_cates_shear_rate": ("steady Wyart-Cates shear rate sigma_in/eta(f_hat(sigma_in))",
+                               _RATE, None),
+    "lower_branch_fraction": ("share psi1 of particles with sigma_i < sigma_beta at the end",
+                              None, "NaN where the steady curve has no turning points"),
+    "upper_branch_fraction": ("share psi2 of particles with sigma_i > sigma_alpha at the end",
+                              None, "NaN where the steady curve has no turning points"),
+    "density": ("reference density rho0 of the run, epsilon sigma_in/(K_f gdot_WC^2)",
+                "sigma_star L_y2 eta_s-2", None),
+    "sound_speed": ("artificial sound speed (Morris criteria)", "sigma_star L_y eta_s-1",
+                    None),
+    "time_step": ("step size at the start", "eta_s sigma_star-1", None),
+    "steps": ("predictor-corrector steps of the run", None, None),
+    "simulated_time": ("simulated time at the end of the run", "eta_s sigma_star-1", None),
+    "reynolds_number": ("Reynolds number rho V L_y/eta_min at the start", None, None),
+    "mach_number": ("Mach number V/c at the start", None, None),
+    "wall_time": ("wall-clock time of the run (set-up and stepping)", None, None),
+}
+_PHYSICAL_UNITS = {"wall_time": "s"}
+
+
+def flow_curve(phi: float, stresses, *, alpha: float = STRONG_NONLOCALITY,
+               lattice: tuple[int, int] = (14, 20), threads: int = 1, epsilon: float = 0.1,
+               equilibration_strain: float = 1.5, averaging_strain: float = 1.5,
+               samples: int = 16, n_blocks: int = 8, phi_m: float = SEED_002["phi_m"],
+               phi_0: float = SEED_002["phi_0"], beta: float = SEED_002["beta"],
+               K_f: float = SEED_002["K_f"]) -> xr.Dataset:
+    """Stress-controlled flow curve of a Wyart–Cates suspension at ``phi`` (module docstring).
+
+    Parameters
+    ----------
+    phi : solid volume fraction φ [1], 0 < φ < φ_0.
+    stresses : imposed stresses σ_in [σ*], positive (one run each, in the given order).
+    alpha : diffusivity of f [L_y² σ*/η_s] (:data:`STRONG_NONLOCALITY` = seed 002's 1e−5 m²/s).
+    lattice : fluid particles (n_x periodic, n_y across the gap).
+    threads : numba threads per run.
+    epsilon : momentum time over microstructure time, sets ρ (and Re = ε/K_f).
+    equilibration_strain, averaging_strain : γ̇_WC t discarded, then averaged.
+    samples, n_blocks : samples over the averaging window, batch-means blocks (samples must be
+        a multiple of n_blocks, n_blocks ≥ 2).
+    phi_m, phi_0, beta, K_f : the rest of the fluid (seed 002 defaults).
+
+    Returns the Dataset of :func:`flow_curve_dataset`. Raises InputError for bad parameters and
+    NumericalError (from the solver) when a run blows up.
+    """
+    stresses = np.atleast_1d(np.asarray(stresses, dtype=float))
+    if stresses.ndim != 1 or stresses.size == 0 or np.any(~(stresses > 0)):
+        raise InputError("flow_curve", f"stresses must be positive numbers, got "
+                         f"{stresses.tolist()}", key="stresses")
+    if int(samples) != samples or int(n_blocks) != n_blocks or n_blocks < 2 \
+            or samples % n_blocks:
+        raise InputError("flow_curve", f"samples = {samples} must be a multiple of n_blocks = "
+                         f"{n_blocks} >= 2", key="samples")
+    for name, value in (("epsilon", epsilon), ("equilibration_strain", equilibration_strain),
+                        ("averaging_strain", averaging_strain), ("K_f", K_f)):
+        if not (value > 0 and math.isfinite(value)):
+            raise InputError("flow_curve", f"{name} = {value!r} must be positive (the density "
+                             "rule needs K_f > 0)", key=name)
+    fluid = WyartCatesFluid(eta_s=1.0, phi=phi, phi_m=phi_m, phi_0=phi_0, sigma_star=1.0,
+                            beta=beta, K_f=K_f, alpha=alpha)
+    geometry = Geometry(int(lattice[0]), int(lattice[1]), 1.0)
+    settings = {"epsilon": float(epsilon), "equilibration_strain": float(equilibration_strain),
+                "averaging_strain": float(averaging_strain), "samples": int(samples),
+                "n_blocks": int(n_blocks), "threads": int(threads)}
+    records = [_point(fluid, geometry, float(s), **settings) for s in stresses]
+    return flow_curve_dataset(fluid, geometry, stresses, records, settings)
+
+
+def _point(fluid, geometry, stress, *, epsilon, equilibration_strain, averaging_strain,
+           samples, n_blocks, threads) -> dict:
+    """One stress-controlled run; the record of :func:`flow_curve_dataset`."""
+    start = wallclock.perf_counter()
+    rate = fluid.shear_rate(stress)
+    density = epsilon * stress / (fluid.K_f * rate ** 2)
+    sim = DSTSimulation(fluid, StressCouette(stress), geometry, Numerics(density=density),
+                        threads=threads)
+    described = sim.describe()
+    dt = described["dt"]
+    sim.advance(int(math.ceil(equilibration_strain / rate / dt)))
+    every = int(math.ceil(averaging_strain / rate / dt / samples))
+    series = []
+    for _ in range(samples):
+        sim.advance(every)
+        series.append(sim.sample())
+    branches = sim.branch_statistics()
+    record = {"time_step": dt, "density": density, "sound_speed": sim.sound_speed,
+              "reynolds_number": described["reynolds"], "mach_number": described["mach"],
+              "steps": sim.steps, "simulated_time": sim.time,
+              "lower_branch_fraction": branches["psi1"],
+              "upper_branch_fraction": branches["psi2"],
+              "n_particles": sim.n_fluid + 2 * sim.n_wall}
+    for name, key in (("shear_rate", "shear_rate"), ("wall_shear_rate", "wall_shear_rate"),
+                      ("measured_stress", "stress"), ("frictional_fraction", "fraction")):
+        estimate = batch_means([s[key] for s in series], n_blocks)
+        record[name] = estimate.mean
+        if name != "frictional_fraction":
+            record[f"{name}_stderr"] = estimate.stderr
+    record["wall_time"] = wallclock.perf_counter() - start
+    log.info("phi %g sigma_in %.4g: <gdot>/gdot_WC %.4f, <sigma>/sigma_in %.4f, %d steps, "
+             "%.1f s", fluid.phi, stress, record["shear_rate"] / rate,
+             record["measured_stress"] / stress, sim.steps, record["wall_time"])
+    return record
+
+
+def flow_curve_dataset(fluid: WyartCatesFluid, geometry: Geometry, stresses, records,
+                       settings: dict, *, command: str | None = None) -> xr.Dataset:
+    """The flow-curve Dataset on ``stress`` from one record (dict) per imposed stress.
+
+    Each record holds the measured variables of :data:`FLOW_CURVE_VARIABLES` (the steady-law
+    ones are computed here from ``fluid``) and ``n_particles``; ``settings`` holds epsilon,
+    the strains, samples, n_blocks and threads. Global attributes: CF ``Conventions``,
+    ``title``, ``source``, ``history``, ``references``, ``unit_system``, every fluid, geometry
+    and study parameter, the turning points (NaN without), ``configuration`` (all of them as
+    JSON), ``wall_time_s``, ``completed`` and the provenance.
+    """
+    stresses = np.asarray(stresses, dtype=float)
+    if len(records) != stresses.size:
+        raise ValueError(f"{len(records)} records for {stresses.size} stresses")
+    law = fluid.steady_law()
+    computed = {"wyart_cates_shear_rate": np.asarray(law.shear_rate(stresses), dtype=float),
+                "steady_frictional_fraction": np.asarray(law.frictional_fraction(stresses),
+                                                         dtype=float)}
+    data = {}
+    for name in FLOW_CURVE_VARIABLES:
+        if name == "stress":
+            continue
+        values = (computed[name] if name in computed
+                  else np.array([float(r.get(name, math.nan)) for r in records]))
+        if name == "steps":
+            values = values.astype(np.int64)
+        data[name] = ("stress", values, _attrs(name))
+    dataset = xr.Dataset(data, coords={"stress": ("stress", stresses, _attrs("stress"))})
+    turning = law.turning_points()
+    parameters = {
+        "eta_s": fluid.eta_s, "phi": fluid.phi, "phi_m": fluid.phi_m, "phi_0": fluid.phi_0,
+        "sigma_star": fluid.sigma_star, "beta": fluid.beta, "K_f": fluid.K_f,
+        "alpha": fluid.alpha, "n_x": geometry.n_x, "n_y": geometry.n_y, "gap": geometry.gap,
+        "smoothing_ratio": geometry.smoothing_ratio, "wall_layers": geometry.wall_layers,
+        **settings}
+    units = {"eta_s": "eta_s", "sigma_star": "sigma_star", "alpha": "L_y2 sigma_star eta_s-1",
+             "gap": "L_y", "sigma_beta": _STRESS, "sigma_alpha": _STRESS, "gdot_max": _RATE,
+             "gdot_min": _RATE}
+    points = {"sigma_beta": math.nan, "gdot_max": math.nan, "sigma_alpha": math.nan,
+              "gdot_min": math.nan}
+    if turning is not None:
+        points = {k: float(v) for k, v in turning._asdict().items()}
+    prov = provenance()
+    wall = float(np.nansum([r.get("wall_time", math.nan) for r in records]))
+    when = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    command = shlex.join(sys.argv) if command is None else command
+    dataset.attrs = {
+        "Conventions": "CF-1.10",
+        "title": f"Stress-controlled 2D SPH flow curve of a Wyart-Cates suspension, "
+                 f"phi = {fluid.phi:g}, alpha = {fluid.alpha:g}",
+        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), "
+                  "suspsim.dst.study.flow_curve",
+        "history": f"{when}: {command}", "references": REFERENCES, "unit_system": UNIT_SYSTEM,
+        **parameters, "regime": law.regime(), **points,
+        "parameter_units": json.dumps(units),
+        "configuration": json.dumps({**parameters, "stresses": stresses.tolist()}),
+        "n_particles": int(records[0].get("n_particles", 0)) if records else 0,
+        "wall_time_s": wall, "completed": 1, **prov}
+    return dataset
+
+
+def _attrs(name: str) -> dict[str, str]:
+    long_name, scaled, comment = FLOW_CURVE_VARIABLES[name]
+    out = {"units": _PHYSICAL_UNITS.get(name, "1"), "long_name": long_name}
+    if scaled:
+        out["simulation_units"] = scaled
+    if comment:
+        out["comment"] = comment
+    return out
+
+
+def spanning_stresses(fluid: WyartCatesFluid, count: int = 13, *, low: float = 0.2,
+                      high: float = 40.0, inside: int | None = None) -> np.ndarray:
+    """``count`` stresses [σ*] from ``low`` to ``high``, log-spaced, crossing both turning points.
+
+    With an S-curve (σ_β < σ_α, both inside (low, high)): ``inside`` stresses (default
+    count // 3) log-spaced strictly between σ_β and σ_α, the rest split between
+    [low, σ_β) and (σ_α, high], each log-spaced, so the unstable branch is sampled as densely
+    as the stable ones. Without (CST, or σ_α = σ_J for φ ≥ φ_m): log-spaced over [low, high].
+    """
+    count = int(count)
+    if count < 3 or not (0 < low < high):
+        raise InputError("spanning_stresses", "need count >= 3 and 0 < low < high", key="count")
+    turning = None if fluid.is_newtonian else fluid.steady_law().turning_points()
+    if turning is None or not (low < turning.sigma_beta < turning.sigma_alpha < high):
+        return np.geomspace(low, high, count)
+    inside = count // 3 if inside is None else int(inside)
+    outside = count - inside
+    below = outside // 2 + outside % 2
+    above = outside - below
+    sb, sa = turning.sigma_beta, turning.sigma_alpha
+    return np.concatenate([np.geomspace(low, sb, below + 1)[:-1],
+                           np.geomspace(sb, sa, inside + 2)[1:-1],
+                           np.geomspace(sa, high, above + 1)[1:]])

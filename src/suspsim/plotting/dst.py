@@ -1,0 +1,99 @@
+"""DST flow-curve figure: stress-controlled SPH points against the steady Wyart–Cates S-curve."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+
+from suspsim.rheology.wyart_cates import WyartCates
+
+#: Points of each parametric S-curve.
+CURVE_POINTS = 400
+
+
+def steady_law(data: xr.Dataset) -> WyartCates:
+    """The steady law of a flow-curve Dataset, from its attributes."""
+    a = data.attrs
+    return WyartCates(a["eta_s"], a["phi"], a["phi_m"], a["phi_0"], a["sigma_star"], a["beta"])
+
+
+def plot_flow_curves(datasets, *, labels=None, residuals: bool = True) -> Figure:
+    """σ against γ̇ (log–log), one colour per dataset (one φ each).
+
+    ``datasets``: outputs of :func:`suspsim.dst.study.flow_curve` (a Dataset or a sequence).
+    Lines: the steady Wyart–Cates curve γ̇(σ) drawn parametrically in σ over the stresses of
+    the data (a factor 1.5 beyond each end), dashed where it is unstable
+    (d ln γ̇/d ln σ < 0); open triangles: its turning points (σ_β, γ̇_max) and
+    (σ_α, γ̇_min) (none for CST; σ_α is left out where γ̇_min = 0, φ ≥ φ_m). Markers:
+    measured domain averages (⟨γ̇⟩, ⟨σ⟩) with standard-error bars. With ``residuals`` a lower
+    panel shows ⟨γ̇⟩/γ̇_WC(σ_in) − 1 against the imposed stress, dotted lines at the turning
+    stresses. ``labels``: legend entries (default φ and the regime). No file I/O.
+    """
+    if isinstance(datasets, xr.Dataset):
+        datasets = [datasets]
+    if residuals:
+        fig = Figure(figsize=(6.4, 7.2), layout="constrained")
+        ax, lower = fig.subplots(2, 1, height_ratios=(3, 1))
+    else:
+        fig = Figure(figsize=(6.4, 5.2), layout="constrained")
+        ax, lower = fig.subplots(), None
+    colours = [colormaps["tab10"](k % 10) for k in range(len(datasets))]
+    for k, (data, colour) in enumerate(zip(datasets, colours)):
+        law = steady_law(data)
+        stress = data["stress"].values
+        label = (labels[k] if labels is not None
+                 else f"φ = {data.attrs['phi']:.2f} ({data.attrs.get('regime', law.regime())})")
+        sigma = np.geomspace(stress.min() / 1.5, stress.max() * 1.5, CURVE_POINTS)
+        rate = np.asarray(law.shear_rate(sigma), dtype=float)
+        with np.errstate(invalid="ignore"):
+            unstable = np.asarray(law.log_slope(sigma)) < 0
+        stable_rate = np.where(unstable, np.nan, rate)
+        unstable_rate = np.where(unstable | np.roll(unstable, 1) | np.roll(unstable, -1),
+                                 rate, np.nan)
+        ax.plot(stable_rate, sigma, "-", color=colour, lw=1.3)
+        ax.plot(unstable_rate, sigma, "--", color=colour, lw=1.1)
+        turning = law.turning_points()
+        if turning is not None:
+            for s, g in ((turning.sigma_beta, turning.gdot_max),
+                         (turning.sigma_alpha, turning.gdot_min)):
+                if np.isfinite(s) and g > 0:
+                    ax.plot(g, s, "^", ms=8, mfc="none", mec=colour, mew=1.3)
+                if np.isfinite(s) and lower is not None:
+                    lower.axvline(s, color=colour, ls=":", lw=0.9)
+        ax.errorbar(data["shear_rate"].values, data["measured_stress"].values,
+                    xerr=_values(data, "shear_rate_stderr"),
+                    yerr=_values(data, "measured_stress_stderr"), fmt="o", ms=4,
+                    color=colour, capsize=2, label=label)
+        if lower is not None:
+            reference = data["wyart_cates_shear_rate"].values
+            error = _values(data, "shear_rate_stderr")
+            lower.errorbar(stress, data["shear_rate"].values / reference - 1.0,
+                           yerr=None if error is None else error / reference, fmt="o-",
+                           ms=4, lw=0.8, color=colour, capsize=2)
+    ax.plot([], [], "k-", lw=1.3, label="Wyart–Cates, stable")
+    ax.plot([], [], "k--", lw=1.1, label="Wyart–Cates, unstable (dlnγ̇/dlnσ < 0)")
+    ax.plot([], [], "k^", ms=8, mfc="none", label="turning points σ_β, σ_α")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("shear rate ⟨γ̇⟩ [σ*/η_s]")
+    ax.set_ylabel("shear stress ⟨σ⟩ [σ*]")
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize="small", loc="lower right")
+    alphas = sorted({float(d.attrs["alpha"]) for d in datasets})
+    ax.set_title("Stress-controlled 2D SPH (markers) vs steady Wyart–Cates (lines)\n"
+                 "non-locality α = " + ", ".join(f"{a:g}" for a in alphas) + " L_y²σ*/η_s",
+                 fontsize="medium")
+    if lower is not None:
+        lower.axhline(0.0, color="0.5", lw=0.8)
+        lower.set_xscale("log")
+        lower.set_xlabel("imposed stress σ_in [σ*]")
+        lower.set_ylabel("⟨γ̇⟩/γ̇_WC(σ_in) − 1 [1]")
+        lower.set_title("relative deviation (dotted: turning points)", fontsize="small")
+        lower.grid(True, alpha=0.3)
+    return fig
+
+
+def _values(data: xr.Dataset, name: str) -> np.ndarray | None:
+    """The variable's values, or None (no error bars) when the Dataset lacks it."""
+    return data[name].values if name in data else None
