@@ -54,6 +54,17 @@ class InclusionSetup:
     reference_count: int
 
 
+def initial_body_motion(scene: Scene, centres: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(V, Ω) (B, 3) at the start: the imposed flow at each centre and its rotation −½ γ̇ ẑ for
+    ``run.start: linear`` Couette, else rest (module docstring)."""
+    velocities = np.zeros((len(centres), 3))
+    omegas = np.zeros((len(centres), 3))
+    if scene.flow.type == "couette" and scene.run.start == "linear":
+        velocities[:, 0] = imposed_velocity(scene, centres[:, 1])
+        omegas[:, 2] = -0.5 * scene.flow.shear_rate
+    return velocities, omegas
+
+
 def scene_packing(scene: Scene) -> Packing:
     """The packing of ``scene``: read from ``inclusions.packing`` or packed from its keys."""
     spec = scene.inclusions
@@ -77,15 +88,9 @@ def build_inclusions(scene: Scene, packing: Packing | None = None) -> InclusionS
     margin = scene.inclusions.fluid_margin * scene.lattice_spacing
     fluid = lattice[fluid_outside_bodies(lattice, packing, np.asarray(scene.box), margin)]
     n_fluid, n_body = len(fluid), len(built.body_index)
-    rate = scene.flow.shear_rate if scene.flow.type == "couette" else 0.0
-    moving = scene.flow.type == "couette" and scene.run.start == "linear"
     centres = built.centres_of_mass(packing.centres, packing.orientations)
     quaternions = principal_orientations(packing.orientations, built.body_to_principal)
-    velocities_b = np.zeros((packing.count, 3))
-    omegas = np.zeros((packing.count, 3))
-    if moving:
-        velocities_b[:, 0] = imposed_velocity(scene, centres[:, 1])
-        omegas[:, 2] = -0.5 * rate
+    velocities_b, omegas = initial_body_motion(scene, centres)
     bodies = RigidBodies.at_rest_in_flow(centres, quaternions, built.mass,
                                          built.principal_moments, velocities_b, omegas)
     positions = np.zeros((n_fluid + n_body, 3))

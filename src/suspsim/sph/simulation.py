@@ -414,12 +414,9 @@ class Simulation:
         self._v[fluid] = initial_velocities(self.scene, self._x[fluid])
         self._a[:] = 0.0
         if self.bodies is not None:
-            moving = self.scene.flow.type == "couette" and self.scene.run.start == "linear"
-            omegas = np.zeros((self.bodies.count, 3))
-            velocities = np.zeros((self.bodies.count, 3))
-            if moving:
-                velocities[:, 0] = imposed_velocity(self.scene, self.bodies.centres[:, 1])
-                omegas[:, 2] = -0.5 * self._rate
+            from suspsim.sph.inclusions import initial_body_motion
+
+            velocities, omegas = initial_body_motion(self.scene, self.bodies.centres)
             self.bodies.set_motion(velocities, omegas)
             self._place_bodies(velocities, omegas, 0.0, self._v)
 
