@@ -104,7 +104,10 @@ LAW_STRATEGIES = {
                                     "lam": _log_uniform(1e-3, 1e3), "m": st.floats(0.05, 1.0)}),
     "carreau_yasuda": st.fixed_dictionaries({"mu_0": _log_uniform(1e-3, 1e3), "mu_inf": _ratio,
                                              "lam": _log_uniform(1e-3, 1e3),
-                                             "a": st.floats(0.1, 10.0), "n": st.floats(0.0, 2.0)}),
+                                             # n = 0 with mu_inf = 0 saturates at mu_0/lam: a
+                                             # stress at the plateau has no finite inverse (the
+                                             # reference says so, as hypothesis found)
+                                             "a": st.floats(0.1, 10.0), "n": st.floats(0.05, 2.0)}),
     "papanastasiou": st.fixed_dictionaries({"mu_pl": _log_uniform(1e-4, 1e2),
                                             "mu_0": _log_uniform(1e-3, 1e5),
                                             "M": _log_uniform(1e-2, 1e6)}),
