@@ -138,7 +138,7 @@ class Simulation:
                 self.relax(scene.lattice.relax_tolerance, scene.lattice.relax_max_steps)
             self._compute_accelerations(self._v, self._a)
             if self.bodies is not None:
-                self.bodies.set_forces(*self._body_forces())
+                self.bodies.set_forces(*self._body_forces(self.bodies.rotations()))
         else:
             for name, attribute in _STATE_ARRAYS.items():
                 getattr(self, attribute)[...] = _state[name]
@@ -292,39 +292,40 @@ class Simulation:
         """Solid volume fraction Σ V_b / V of the bodies (0 without inclusions)."""
         return 0.0 if self.bodies is None else float(self._body_volume / self.scene.volume)
 
-    def _place_bodies(self, velocities, omegas, time: float, out) -> None:
-        """Body particles at their rigid positions; their velocities into ``out``."""
+    def _place_bodies(self, rotations, velocities, omegas, time: float, out) -> None:
+        """Body particles at their rigid positions (``rotations`` (B, 3, 3) of the bodies'
+        current orientations); their velocities into ``out``."""
         place_body_particles(self._members, self._body_of, self._offsets, self.bodies.centres,
-                             self.bodies.rotations(), velocities, omegas, self._box,
-                             self._offset(time), self._rate, self._x, out)
+                             rotations, velocities, omegas, self._box, self._offset(time),
+                             self._rate, self._x, out)
 
-    def _body_forces(self) -> tuple[np.ndarray, np.ndarray]:
+    def _body_forces(self, rotations) -> tuple[np.ndarray, np.ndarray]:
         """(F, T) of every body from the last force pass; updates the stress correction."""
         b = self.bodies.count
         forces, torques = np.zeros((b, 3)), np.zeros((b, 3))
-        body_force_torque(self._members, self._body_of, self._offsets, self.bodies.rotations(),
+        body_force_torque(self._members, self._body_of, self._offsets, rotations,
                           self._force_acc, FORCE_WIDTH, forces, torques, self._body_virial)
         return forces, torques
 
     def _lubrication_setup(self):
-        """(s_c, s_min, C per body pair scale, scalar inertia) or None (``inclusions.lubrication``)."""
+        """(s_c, s_min, repulsion C, scalar inertia) or None (``inclusions.lubrication``):
+        C = k μ(γ̇) γ̇ ā² s_min⁸ with ā the bodies' mean radius."""
         spec = self.scene.inclusions.lubrication
         if self.bodies is None or not spec.enabled:
             return None
         rate = self._rate
-        scale = (spec.repulsion * float(self.scene.fluid.law.viscosity(rate)) * rate
-                 * spec.min_gap ** 8)
-        return spec.cutoff_gap, spec.min_gap, scale, self.bodies.moments.mean(axis=1)
+        strength = (spec.repulsion * float(self.scene.fluid.law.viscosity(rate)) * rate
+                    * float(np.mean(self._body_radii)) ** 2 * spec.min_gap ** 8)
+        return spec.cutoff_gap, spec.min_gap, strength, self.bodies.moments.mean(axis=1)
 
     def _lubricate(self, time: float) -> None:
         """Implicit lubrication impulses on the kicked bodies (``bodies.lubrication_pass``)."""
         bodies, law = self.bodies, self.scene.fluid.law
-        cutoff, min_gap, scale, inertia = self._lubrication
+        cutoff, min_gap, strength, inertia = self._lubrication
         omegas = bodies.angular_velocities()
-        mean_radius2 = float(np.mean(self._body_radii)) ** 2
         lubrication_pass(bodies.centres, self._body_radii, bodies.velocities, omegas,
                          bodies.mass, inertia, self._box, self._offset(time), self._rate,
-                         self.dt, law.code, law.packed, cutoff, min_gap, scale * mean_radius2,
+                         self.dt, law.code, law.packed, cutoff, min_gap, strength,
                          self._lubrication_virial, self._lubrication_stats)
         bodies.set_angular_velocities(omegas)
 
@@ -339,24 +340,27 @@ class Simulation:
             drift(self._x, self._v, self._a, dt)
             if bodies is not None:
                 bodies.drift(dt)
-                self._place_bodies(bodies.velocities, bodies.angular_velocities(), time,
-                                   self._v)
+                # Orientations change only in the drift: one set of rotations for the step.
+                rotations = bodies.rotations()
+                predicted = bodies.predicted(dt)
+                # Positions for the rebuild test; the velocities written here are replaced.
+                self._place_bodies(rotations, *predicted, time, self._v)
             nl = self._nlist
             if needs_rebuild(self._x, self._reference, self._rate * (time - self._build_time),
                              nl.cutoff, nl.skin, 0.5 * self._box[1]):
                 self._rebuild(time)
             predict(self._v, self._a, dt, self._v_pred)
             if bodies is not None:
-                self._place_bodies(*bodies.predicted(dt), time, self._v_pred)
+                self._place_bodies(rotations, *predicted, time, self._v_pred)
             box, *rest = self._physics_args()
             accelerations(self._x, self._v_pred, box, self._offset(time), *rest, self._a_new)
             kick(self._v, self._a, self._a_new, dt)
             if bodies is not None:
-                bodies.kick(*self._body_forces(), dt)
+                bodies.kick(*self._body_forces(rotations), dt)
                 if self._lubrication is not None:
                     self._lubricate(time)
-                self._place_bodies(bodies.velocities, bodies.angular_velocities(), time,
-                                   self._v)
+                self._place_bodies(rotations, bodies.velocities, bodies.angular_velocities(),
+                                   time, self._v)
             if self._shifting > 0.0:
                 tb = self._table
                 shift_particles(self._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
@@ -378,22 +382,23 @@ class Simulation:
         self._v[:] = 0.0
         self._a[:] = 0.0
         still = np.zeros((self.bodies.count if self.bodies is not None else 0, 3))
+        rotations = self.bodies.rotations() if self.bodies is not None else None
         error, steps = self._density_error(), 0
         while error > tolerance and steps < max_steps:
             drift(self._x, self._v, self._a, dt)
             if self.bodies is not None:
-                self._place_bodies(still, still, 0.0, self._v)
+                self._place_bodies(rotations, still, still, 0.0, self._v)
             nl = self._nlist
             if needs_rebuild(self._x, self._reference, 0.0, nl.cutoff, nl.skin):
                 self._rebuild(0.0)
             predict(self._v, self._a, dt, self._v_pred)
             if self.bodies is not None:
-                self._place_bodies(still, still, 0.0, self._v_pred)
+                self._place_bodies(rotations, still, still, 0.0, self._v_pred)
             self._compute_accelerations(self._v_pred, self._a_new)
             kick(self._v, self._a, self._a_new, dt)
             self._v *= 1.0 - RELAX_DAMPING
             if self.bodies is not None:
-                self._place_bodies(still, still, 0.0, self._v)
+                self._place_bodies(rotations, still, still, 0.0, self._v)
             steps += 1
             if steps % RELAX_CHECK == 0:
                 error = self._density_error()
@@ -418,7 +423,7 @@ class Simulation:
 
             velocities, omegas = initial_body_motion(self.scene, self.bodies.centres)
             self.bodies.set_motion(velocities, omegas)
-            self._place_bodies(velocities, omegas, 0.0, self._v)
+            self._place_bodies(self.bodies.rotations(), velocities, omegas, 0.0, self._v)
 
     def memory_bytes(self) -> int:
         """Bytes held by the particle arrays, the neighbour list, the pair table and scratch."""
