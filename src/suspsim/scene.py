@@ -217,10 +217,10 @@ class Scene:
                 "inclusions": asdict(self.inclusions), "seed": self.seed}
 
 
-def _lattice(data: Mapping[str, Any], inclusions: Mapping[str, Any]) -> LatticeSpec:
+def _lattice(data: Mapping[str, Any], inclusions: InclusionsSpec) -> LatticeSpec:
     relax = data["relax"]
     if relax == "auto":
-        relax = float(inclusions["phi"]) > 0.0 or inclusions["packing"] is not None
+        relax = inclusions.present
     return LatticeSpec(float(data["jitter"]), bool(relax), float(data["relax_tolerance"]),
                        int(data["relax_max_steps"]))
 
@@ -267,6 +267,7 @@ def _build(data, source: str, lines: Mapping[tuple, int]) -> Scene:
                          f"not a {type(data).__name__}")
     validate(data, SCENE_SCHEMA, source=source, lines=lines)
     full, law = resolve(fill_defaults(data, SCENE_SCHEMA), data["run"], partial(_fail, source, lines))
+    inclusions = _inclusions(full["inclusions"])
     run = {f.name: full["run"].get(f.name) for f in fields(RunSpec)}
     run.update({key: None for key in ("dt", "sound_speed", "threads") if run[key] in ("auto", "all")})
     numerics = {f.name: float(full["numerics"][f.name]) if f.type == "float" else full["numerics"][f.name]
@@ -274,7 +275,6 @@ def _build(data, source: str, lines: Mapping[tuple, int]) -> Scene:
     return Scene(dimension=full["dimension"], box=tuple(float(s) for s in full["box"]),
                  number_density=float(full["number_density"]), kernel=full["kernel"],
                  fluid=FluidSpec(law), flow=FlowSpec(**full["flow"]), run=RunSpec(**run),
-                 lattice=_lattice(full["lattice"], full["inclusions"]),
-                 numerics=NumericsSpec(**numerics),
-                 inclusions=_inclusions(full["inclusions"]),
+                 lattice=_lattice(full["lattice"], inclusions),
+                 numerics=NumericsSpec(**numerics), inclusions=inclusions,
                  seed=int(full["seed"]), source=source)
