@@ -29,6 +29,7 @@ import numpy as np
 from suspsim.dst import integrator as _int
 from suspsim.dst.parameters import Channel, Geometry, Numerics, StressCouette, WyartCatesFluid
 from suspsim.errors import InputError, NumericalError
+from suspsim.threads import use_threads
 
 log = logging.getLogger(__name__)
 
@@ -178,7 +179,7 @@ class DSTSimulation:
 
     # ------------------------------------------------------------------ running
     def _run(self, function, *args):
-        numba.set_num_threads(self.threads)
+        use_threads(self.threads)
         while True:
             result = function(*args)
             code = result[0] if isinstance(result, tuple) else result

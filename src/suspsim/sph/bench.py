@@ -24,6 +24,7 @@ import numpy as np
 from suspsim.scene import scene_from_dict
 from suspsim.sph.density import mass_density, summation_density
 from suspsim.sph.simulation import SUPPORT, Simulation
+from suspsim.threads import use_threads
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
                                              _normalisation_finish)
@@ -106,7 +107,7 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     dissipation sums and normalisation finish (when the scene normalises), force sums and
     finish. Their sum is the step without drift, kick and rebuilds.
     """
-    numba.set_num_threads(sim.threads)
+    use_threads(sim.threads)
     box, tb, nl = sim._box, sim._table, sim._nlist
     law = sim.scene.fluid.law
     shear_ly = sim._rate * box[1]

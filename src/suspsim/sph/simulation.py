@@ -46,6 +46,7 @@ from suspsim.sph.terms.shifting import shift_particles
 from suspsim.sph.terms.velocity_pass import GRADIENT_WIDTH
 from suspsim.sph.terms.viscous import bulk_factor, viscous_weights
 from suspsim.sph.timestep import auto_sound_speed, stable_time_step
+from suspsim.threads import use_threads
 
 log = logging.getLogger(__name__)
 
@@ -246,7 +247,7 @@ class Simulation:
                 self._scratch_6, self._bounds, self._virial)
 
     def _compute_accelerations(self, predicted, out) -> None:
-        numba.set_num_threads(self.threads)
+        use_threads(self.threads)
         box, *rest = self._physics_args()
         accelerations(self._x, predicted, box, self._offset(self.time), *rest, out)
 
@@ -263,7 +264,7 @@ class Simulation:
 
     def advance(self, n_steps: int) -> None:
         """Run ``n_steps`` steps in compiled code; Python only rebuilds the neighbour list."""
-        numba.set_num_threads(self.threads)
+        use_threads(self.threads)
         if self.bodies is not None or self._shifting > 0.0:
             self._advance_python(int(n_steps))
             return
