@@ -1,7 +1,8 @@
 """The ``suspsim`` command line: ``suspsim fit FILE [--law NAME|auto] [--sample ID] [--out F] [--plot F]``.
 
 Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N]`` (an SPH run, see
-:mod:`suspsim.run`), ``suspsim bench [--scene NAME] [--threads N] [--steps K] [--json]`` and
+:mod:`suspsim.run`, or a DST run of a wyart_cates scene, see :mod:`suspsim.dst.run`),
+``suspsim bench [--scene NAME] [--threads N] [--steps K] [--json]`` and
 ``suspsim pack --shape sphere|sand --phi PHI --radius A --box LX LY LZ --out PACK.nc
 [--polydispersity S] [--seed N] ...`` (a random packing, see :mod:`suspsim.bodies.packing`).
 
@@ -50,7 +51,7 @@ def _build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--out", help="write the fit as JSON (SI units)")
     fit.add_argument("--plot", help="write a figure of data and fit (.png, .pdf, .svg)")
 
-    run = sub.add_parser("run", help="run an SPH scene and write its results as netCDF")
+    run = sub.add_parser("run", help="run an SPH or DST scene and write its results as netCDF")
     run.add_argument("scene", help="scene file (YAML)")
     run.add_argument("--out", required=True, help="output netCDF file; its checkpoint is "
                      "OUT.ckpt.npz beside it until the run completes")
@@ -125,20 +126,40 @@ def _cmd_fit(args) -> int:
 
 def _cmd_run(args) -> int:
     from .io.netcdf import read_run
-    from .run import run_scene
-    from .scene import load_scene
+    from .scene import Scene, load_any_scene
 
-    scene = load_scene(args.scene)
-    out = run_scene(scene, args.out, resume=args.resume, threads=args.threads)
+    scene = load_any_scene(args.scene)
+    if isinstance(scene, Scene):
+        from .run import run_scene
+
+        out = run_scene(scene, args.out, resume=args.resume, threads=args.threads)
+    else:
+        from .dst.run import run_dst_scene
+
+        out = run_dst_scene(scene, args.out, resume=args.resume, threads=args.threads)
     result = read_run(out)
     if "viscosity" in result:
         print(f"viscosity {float(result['viscosity']):.6g} ± "
               f"{float(result['viscosity_stderr']):.2g} "
               f"[{result['viscosity'].attrs.get('simulation_units', '1')}]")
+    if "imposed_stress" in result:
+        print(f"flow-curve point: shear rate {_value(result, 'mean_shear_rate')}, stress "
+              f"{_value(result, 'mean_stress')} at imposed stress "
+              f"{float(result['imposed_stress']):.6g} (Wyart-Cates shear rate "
+              f"{float(result['wyart_cates_shear_rate']):.6g})")
+    if "reference_bulk_velocity" in result:
+        print(f"bulk velocity {_value(result, 'mean_bulk_velocity')} (local-model reference "
+              f"{float(result['reference_bulk_velocity']):.6g})")
     print(f"Reynolds number {result.attrs['reynolds_number']:.3g}, largest Mach number "
           f"{result.attrs['mach_number']:.3g}, {result.attrs['particle_steps_per_s']:.3g} "
           f"particle-steps/s; wrote {out}")
     return 0
+
+
+def _value(result, name: str) -> str:
+    """``mean ± stderr [units]`` of a steady-window mean in a run file."""
+    units = result[name].attrs.get("simulation_units", result[name].attrs.get("units", "1"))
+    return (f"{float(result[name]):.6g} ± {float(result[f'{name}_stderr']):.2g} [{units}]")
 
 
 def _cmd_bench(args) -> int:

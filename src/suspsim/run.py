@@ -16,6 +16,10 @@ removed once the output is written. An interrupted run raises :class:`RunInterru
 (exit code 128 + signal: 130 for SIGINT, 143 for SIGTERM); a blow-up raises
 :class:`~suspsim.errors.NumericalError` naming the limit and keeps the last good checkpoint.
 
+The loop itself (:func:`drive`) is shared with the DST solver (:mod:`suspsim.dst.run`): it
+asks a *schedule* when to sample and stop — here :class:`Plan`, in steps; there, in simulated
+time — and a simulation for ``advance``, ``step_count``, ``health``, ``state``.
+
 Output (:mod:`suspsim.io.netcdf`): the time series, the steady-window profiles, and for couette
 ``viscosity`` = ⟨σ_xy⟩/γ̇ with ``viscosity_stderr`` from
 :func:`~suspsim.analysis.steady.steady_mean` (batch means over ≥ 8 blocks of whole strain
@@ -32,7 +36,7 @@ import time
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -89,26 +93,51 @@ class Plan:
     def is_steady(self, step: int) -> bool:
         return step > self.transient_steps or step == self.total_steps
 
+    # The schedule protocol of drive(): progress in steps, samples at whole multiples.
+    def finished(self, sim) -> bool:
+        return sim.step_count >= self.total_steps
+
+    def advance(self, sim, n_steps: int) -> None:
+        """At most ``n_steps``, never past the next sample."""
+        sim.advance(min(n_steps, self.next_sample(sim.step_count) - sim.step_count))
+
+    def sample_due(self, sim, record: "Record") -> bool:
+        return sim.step_count == self.next_sample(sim.step_count - 1)
+
+    def expected_steps(self, sim) -> int:
+        return self.total_steps
+
 
 class Record:
-    """The loop's accumulators: time series and profile sums over the steady window."""
+    """The loop's accumulators: time series and profile sums over the steady window.
+
+    ``sample_names`` and ``profile_names`` (class attributes) are the registry names kept;
+    a solver with other diagnostics subclasses with its own.
+    """
+
+    sample_names: tuple[str, ...] = SAMPLE_NAMES
+    profile_names: tuple[str, ...] = PROFILE_NAMES
 
     def __init__(self, series: dict[str, np.ndarray] | None = None,
                  sums: dict[str, np.ndarray] | None = None, n_profiles: int = 0):
-        names = ("step", "time", "strain", *SAMPLE_NAMES)
+        names = ("step", "time", "strain", *self.sample_names)
         self.series = {k: list((series or {}).get(k, ())) for k in names}
         self.sums = dict(sums or {})
         self.n_profiles = int(n_profiles)
 
+    @property
+    def n_samples(self) -> int:
+        return len(self.series["step"])
+
     def add_sample(self, step: int, time_: float, strain: float, scalars: dict[str, float]) -> None:
         for name, value in (("step", step), ("time", time_), ("strain", strain)):
             self.series[name].append(value)
-        for name in SAMPLE_NAMES:
+        for name in self.sample_names:
             self.series[name].append(float(scalars[name]))
 
     def add_profiles(self, profiles: dict[str, np.ndarray]) -> None:
         self.sums["y"] = np.asarray(profiles["y"], dtype=float)
-        for name in PROFILE_NAMES:
+        for name in self.profile_names:
             value = np.asarray(profiles[name], dtype=float)
             self.sums[name] = self.sums[name] + value if name in self.sums else value.copy()
         self.n_profiles += 1
@@ -140,65 +169,129 @@ def run_scene(scene: Scene | str | PathLike, out_path: str | PathLike, *, resume
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     out, ckpt = Path(out_path), checkpoint_path(out_path)
     threads = scene.run.threads if threads is None else threads
-    sim, record, wall_before = _start(scene, ckpt, resume, simulation_factory or _solver(), threads)
+    sim, record, wall_before = start_simulation(scene, ckpt, resume,
+                                                simulation_factory or _solver(), threads, Record)
     plan = Plan.for_scene(scene, sim.dt)
     log.info("%d particles, dt %.4g tau, sound speed %.4g h/tau: %d steps, a sample every %d, "
              "checkpoint %s", sim.n_particles, sim.dt, sim.sound_speed, plan.total_steps,
              plan.steps_per_sample, ckpt)
-    progress = progress or ProgressReporter()
     strain_run = scene.run.strain is not None
-    progress.begin(scene.run.length, "strain" if strain_run else "time")
+    segment = Segment(scene=scene, ckpt=ckpt, progress=progress or ProgressReporter(),
+                      clock=clock, started=started, wall_before=wall_before,
+                      checkpoint_interval_s=scene.run.checkpoint_interval_s,
+                      unit="strain" if strain_run else "time", length=scene.run.length,
+                      done=lambda sim: sim.strain if strain_run else sim.time)
 
-    def done() -> float:
-        return sim.strain if strain_run else sim.time
+    def take_sample(sim, record: Record, check: Callable[[], None]) -> None:
+        scalars = sim.sample()
+        record.add_sample(sim.step_count, sim.time, sim.strain, scalars)
+        check()
+        if plan.is_steady(sim.step_count):
+            record.add_profiles(sim.profiles(scene.run.profile_bins))
 
-    def where() -> str:
-        return f"{progress.unit} {done():.4g} (step {sim.step_count})"
-
-    def save() -> None:
-        _check_health(sim, f"{progress.unit} {done():.4g}", ckpt, before_checkpoint=True)
-        meta = {"wall_time_s": wall_before + clock() - started, "step": sim.step_count}
-        state = {**_flatten(sim.state(), "sim/"), **_flatten(record.to_state(), "run/")}
-        save_checkpoint(ckpt, state, meta, scene=scene)
-
-    pace = _Pace(clock)
-    last_save = clock()
-    with graceful_interrupt() as stop:
-        progress.update(done(), sim.step_count, plan.total_steps, force=True)
-        try:
-            while sim.step_count < plan.total_steps:
-                target = plan.next_sample(sim.step_count)
-                pace.advance(sim, target - sim.step_count)
-                if sim.step_count == target:
-                    _take_sample(sim, record, plan, scene, ckpt, f"{progress.unit} {done():.4g}")
-                progress.update(done(), sim.step_count, plan.total_steps)
-                if stop.requested:
-                    save()
-                    raise RunInterrupted(f"interrupted at {where()}; checkpoint saved to {ckpt}; "
-                                         f"resume with --resume", stop.signum)
-                if clock() - last_save >= scene.run.checkpoint_interval_s:
-                    save()
-                    last_save = clock()
-            progress.update(done(), sim.step_count, plan.total_steps, force=True)
-        finally:
-            progress.close()
-    wall = wall_before + clock() - started
+    wall = drive(sim, record, plan, take_sample, segment)
     _write_output(out, scene, sim, record, plan, wall)
     ckpt.unlink(missing_ok=True)
     return out
 
 
-def _start(scene: Scene, ckpt: Path, resume: bool, factory, threads: int | None):
-    """The simulation, the accumulators and the wall time of earlier segments [s]."""
+@dataclass(frozen=True)
+class Segment:
+    """What :func:`drive` needs besides the simulation, for one segment of a run.
+
+    ``scene`` (anything with ``to_dict()``, hashed into the checkpoint), ``ckpt`` the
+    checkpoint path, ``clock`` wall seconds, ``started`` its reading at the segment's start,
+    ``wall_before`` [s] the wall time of earlier segments, ``unit`` and ``length`` of the run
+    (strain or time) and ``done(sim)`` how far it is in that unit.
+    """
+
+    scene: Any
+    ckpt: Path
+    progress: ProgressReporter
+    clock: Callable[[], float]
+    started: float
+    wall_before: float
+    checkpoint_interval_s: float
+    unit: str
+    length: float
+    done: Callable[[Any], float]
+
+    def wall_time(self) -> float:
+        """Wall seconds of this and the earlier segments."""
+        return self.wall_before + self.clock() - self.started
+
+
+def drive(sim, record: Record, schedule, take_sample, segment: Segment) -> float:
+    """Advance ``sim`` to the end of ``schedule``; return the wall time of all segments [s].
+
+    ``schedule`` has ``finished(sim)``, ``advance(sim, n)`` (at most n steps, none past the
+    next sample), ``sample_due(sim, record)`` and ``expected_steps(sim)`` (for the ETA);
+    ``take_sample(sim, record, check)`` records a sample and calls ``check()`` (the health
+    check) before anything that a failed state would spoil. Order per piece: advance about
+    :data:`POLL_S` wall seconds, sample if due, report progress, save and stop on a signal,
+    checkpoint when due. A NumericalError from ``advance`` gets the place and the checkpoint
+    note of a failed health check.
+    """
+    ckpt, clock, progress = segment.ckpt, segment.clock, segment.progress
+    progress.begin(segment.length, segment.unit)
+
+    def here() -> str:
+        return f"{segment.unit} {segment.done(sim):.4g}"
+
+    def report(force: bool = False) -> None:
+        progress.update(segment.done(sim), sim.step_count, schedule.expected_steps(sim),
+                        force=force)
+
+    def save() -> None:
+        _check_health(sim, here(), ckpt, before_checkpoint=True)
+        meta = {"wall_time_s": segment.wall_time(), "step": sim.step_count}
+        state = {**_flatten(sim.state(), "sim/"), **_flatten(record.to_state(), "run/")}
+        save_checkpoint(ckpt, state, meta, scene=segment.scene)
+
+    pace = _Pace(clock)
+    last_save = clock()
+    with graceful_interrupt() as stop:
+        report(force=True)
+        try:
+            while not schedule.finished(sim):
+                try:
+                    pace.advance(sim, lambda n: schedule.advance(sim, n))
+                except NumericalError as err:
+                    raise _failure(str(err), here(), ckpt) from None
+                if schedule.sample_due(sim, record):
+                    take_sample(sim, record, lambda: _check_health(sim, here(), ckpt))
+                report()
+                if stop.requested:
+                    save()
+                    raise RunInterrupted(f"interrupted at {here()} (step {sim.step_count}); "
+                                         f"checkpoint saved to {ckpt}; resume with --resume",
+                                         stop.signum)
+                if clock() - last_save >= segment.checkpoint_interval_s:
+                    save()
+                    last_save = clock()
+            report(force=True)
+        finally:
+            progress.close()
+    return segment.wall_time()
+
+
+def start_simulation(scene, ckpt: Path, resume: bool, factory, threads: int | None,
+                     record_class: type[Record] = Record):
+    """The simulation, the accumulators and the wall time of earlier segments [s].
+
+    ``factory(scene, threads=)`` builds a fresh simulation, ``factory.from_state(scene, state,
+    threads=)`` one from a checkpoint's state.
+    """
     if resume:
         state, meta = load_checkpoint(ckpt, scene)
         sim = factory.from_state(scene, _unflatten(_strip(state, "sim/")), threads=threads)
         log.info("resuming from %s at step %d", ckpt, sim.step_count)
-        return sim, Record.from_state(_unflatten(_strip(state, "run/"))), float(meta["wall_time_s"])
+        record = record_class.from_state(_unflatten(_strip(state, "run/")))
+        return sim, record, float(meta["wall_time_s"])
     if ckpt.exists():
         raise InputError(ckpt, "an interrupted run left this checkpoint; add --resume to "
                          "continue it, or delete it to start afresh")
-    return factory(scene, threads=threads), Record(), 0.0
+    return factory(scene, threads=threads), record_class(), 0.0
 
 
 class _Pace:
@@ -207,33 +300,31 @@ class _Pace:
     def __init__(self, clock):
         self.clock, self.steps = clock, 1
 
-    def advance(self, sim, remaining: int) -> None:
-        n = min(remaining, self.steps)
+    def advance(self, sim, advance: Callable[[int], None]) -> None:
+        """Call ``advance(n)`` (which may take fewer than n steps) and adapt n to the speed."""
+        before = sim.step_count
         t0 = self.clock()
-        sim.advance(n)
+        advance(self.steps)
         elapsed = self.clock() - t0
+        n = max(1, sim.step_count - before)
         # Grow at most eightfold: the first calls may include compilation.
         wanted = n * POLL_S / elapsed if elapsed > 0 else 8 * n
         self.steps = max(1, min(int(wanted), 8 * n))
 
 
-def _take_sample(sim, record: Record, plan: Plan, scene: Scene, ckpt: Path, where: str) -> None:
-    scalars = sim.sample()
-    record.add_sample(sim.step_count, sim.time, sim.strain, scalars)
-    _check_health(sim, where, ckpt)
-    if plan.is_steady(sim.step_count):
-        record.add_profiles(sim.profiles(scene.run.profile_bins))
-
-
 def _check_health(sim, where: str, ckpt: Path, *, before_checkpoint: bool = False) -> None:
     ok, message = sim.health()
-    if ok:
-        return
+    if not ok:
+        raise _failure(message, where, ckpt, before_checkpoint=before_checkpoint)
+
+
+def _failure(message: str, where: str, ckpt: Path, *,
+             before_checkpoint: bool = False) -> NumericalError:
     kept = (f"the last good checkpoint is kept at {ckpt} for inspection; after changing the "
             f"setting, --resume continues from it" if ckpt.exists()
             else "no checkpoint had been written yet")
     note = ", not checkpointed" if before_checkpoint else ""
-    raise NumericalError(f"{message} [{where}{note}]; {kept}")
+    return NumericalError(f"{message} [{where}{note}]; {kept}")
 
 
 def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall: float) -> None:

@@ -23,7 +23,7 @@ from typing import Any, Mapping, NoReturn
 import numpy as np
 
 from .errors import InputError
-from .io.schema import dotted_key, fill_defaults, load_schema, validate
+from .io.schema import fail_at, fill_defaults, load_schema, validate
 from .io.yamlfile import load_yaml
 from .rheology.laws import ConstitutiveLaw
 from .scene_rules import lattice_counts, resolve
@@ -108,6 +108,7 @@ class NumericsSpec:
     viscous_normalisation: bool
     wi_target: float
     shifting: float
+    pressure_reference: str
     dt_viscous_coefficient: float
 
 
@@ -241,6 +242,18 @@ def load_scene(path: str | PathLike) -> Scene:
     return _build(data, str(path), lines)
 
 
+def load_any_scene(path: str | PathLike):
+    """Read and validate a scene file of either solver: a :class:`Scene`, or a
+    :class:`suspsim.dst.scene.DSTScene` when ``fluid.law`` is wyart_cates or ``flow.type`` is
+    stress_couette or channel (:func:`suspsim.dst.scene.is_dst_scene`)."""
+    from .dst.scene import build_dst_scene, is_dst_scene
+
+    data, lines = load_yaml(path)
+    if is_dst_scene(data):
+        return build_dst_scene(data, str(path), lines)
+    return _build(data, str(path), lines)
+
+
 def scene_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scene:
     """Validate a scene given as a mapping (tuples and NumPy scalars are accepted)."""
     return _build(_plain(data), source, {})
@@ -255,8 +268,7 @@ def _plain(data):
 
 
 def _fail(source: str, lines: Mapping[tuple, int], path: tuple, problem: str) -> NoReturn:
-    line = next((lines[path[:i]] for i in range(len(path), 0, -1) if path[:i] in lines), None)
-    raise InputError(source, problem, line=line, key=dotted_key(path) or None)
+    fail_at(source, lines, path, problem)
 
 
 def _build(data, source: str, lines: Mapping[tuple, int]) -> Scene:

@@ -2,7 +2,7 @@
 
 :func:`resolve` takes a scene that passed the schema (defaults filled) and returns it complete:
 run length rules checked, ``run.start``, ``run.output_interval``, ``run.transient`` and
-``run.profile_bins`` resolved, numbers as floats. ``run.dt``, ``run.sound_speed`` ("auto") and
+``run.profile_bins``, ``numerics.shifting`` and ``numerics.pressure_reference`` resolved, numbers as floats. ``run.dt``, ``run.sound_speed`` ("auto") and
 ``run.threads`` ("all") stay for the solver. Problems go to ``fail(key_path, problem)``, which
 raises. Units as in :mod:`suspsim.scene`.
 """
@@ -41,6 +41,8 @@ def resolve(scene: dict, given_run: dict, fail: Fail) -> tuple[dict, Constitutiv
     out["run"] = _resolve_run(scene["run"], given_run, out["flow"], scene["box"], fail)
     _check_lattice(out["dimension"], scene["box"], scene["number_density"], fail)
     _check_inclusions(out, fail)
+    out["numerics"] = _resolve_numerics(scene["numerics"], _has_inclusions(scene["inclusions"]),
+                                        out["flow"], fail)
     return out, law
 
 
@@ -70,6 +72,33 @@ def _make_law(fluid: dict, fail: Fail) -> ConstitutiveLaw:
         named = re.match(r"\w+: (?:parameter )?(\w+)\b", str(err))
         which = (named.group(1),) if named and named.group(1) in params else ()
         fail(("fluid", "params", *which), str(err))
+
+
+#: Shifting coefficient A of numerics.shifting auto in a scene with inclusions [choice]: one
+#: sphere then carries its Einstein stresslet and the fluid around it its viscosity (the
+#: schema's description gives the measurements).
+AUTO_SHIFTING_WITH_INCLUSIONS = 30.0
+
+
+def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, fail: Fail) -> dict:
+    """``shifting`` auto → :data:`AUTO_SHIFTING_WITH_INCLUSIONS` with inclusions, 0 without;
+    ``pressure_reference`` auto → fluid_mean where shifting acts, nominal elsewhere; an
+    explicit fluid_mean where it does not is refused (particles pair up, SPEC §2.3).
+    Shifting acts only in a sheared flow: its diffusivity A h² γ̇ δt scales with the imposed
+    shear rate (``terms.shifting``), which a poiseuille flow does not have."""
+    out = dict(numerics)
+    if numerics["shifting"] == "auto":
+        out["shifting"] = AUTO_SHIFTING_WITH_INCLUSIONS if inclusions_present else 0.0
+    out["shifting"] = float(out["shifting"])
+    reference = numerics["pressure_reference"]
+    shifting = out["shifting"] > 0.0 and flow["type"] == "couette"
+    if reference == "auto":
+        out["pressure_reference"] = "fluid_mean" if shifting else "nominal"
+    elif reference == "fluid_mean" and not shifting:
+        fail(("numerics", "pressure_reference"), "fluid_mean needs numerics.shifting > 0 in a "
+             "couette flow (with a zero mean pressure nothing else keeps the particles from "
+             "pairing up); set shifting, e.g. 30, or use nominal")
+    return out
 
 
 def _check_flow(flow: dict, fail: Fail) -> dict:
@@ -134,9 +163,13 @@ def _check_lattice(dim: int, box, n: float, fail: Fail) -> None:
              f"sides that are multiples of the spacing {spacing:.4g} h, e.g. [{fitting}]")
 
 
+def _has_inclusions(inc: dict) -> bool:
+    return inc["phi"] > 0 or inc["packing"] is not None
+
+
 def _check_inclusions(scene: dict, fail: Fail) -> None:
     inc = scene["inclusions"]
-    if not (inc["phi"] > 0 or inc["packing"] is not None):
+    if not _has_inclusions(inc):
         return
     if scene["dimension"] != 3:
         fail(("inclusions",), "rigid inclusions need a 3-D scene")

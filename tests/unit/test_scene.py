@@ -208,3 +208,24 @@ def test_schema_is_valid_and_documents_every_key():
         assert sub.get("description"), path
         if not required and path not in {("run", "strain"), ("run", "time")}:
             assert "default" in sub, path
+
+
+@pytest.mark.parametrize("numerics, expected", [
+    ("{}", "nominal"), ("{shifting: 30}", "fluid_mean"),
+    ("{shifting: 30, pressure_reference: nominal}", "nominal")])
+def test_pressure_reference_auto_follows_shifting(tmp_path, numerics, expected):
+    scene = load_scene(_write(tmp_path, MINIMAL + f"numerics: {numerics}\n"))
+    assert scene.numerics.pressure_reference == expected
+
+
+def test_fluid_mean_pressure_reference_needs_shifting(tmp_path):
+    with pytest.raises(InputError, match="numerics.pressure_reference.*shifting"):
+        load_scene(_write(tmp_path, MINIMAL + "numerics: {pressure_reference: fluid_mean}\n"))
+
+
+def test_shifting_auto_is_on_only_with_inclusions(tmp_path):
+    fluid = load_scene(_write(tmp_path, MINIMAL))
+    suspension = load_scene(_write(tmp_path, MINIMAL + "inclusions: {phi: 0.1, radius: 2.0}\n"))
+    assert (fluid.numerics.shifting, fluid.numerics.pressure_reference) == (0.0, "nominal")
+    assert suspension.numerics.shifting == 30.0
+    assert suspension.numerics.pressure_reference == "fluid_mean"

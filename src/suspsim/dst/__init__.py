@@ -12,7 +12,10 @@ and a Wyart–Cates microstructure f per particle.
 - :mod:`~suspsim.dst.passes`: wall pass (Adami 2012) and fluid pass;
 - :mod:`~suspsim.dst.integrator`: rate evaluation, step size, predictor–corrector, shifting;
 - :mod:`~suspsim.dst.simulation`: :class:`DSTSimulation` (advance, sample, profiles,
-  snapshot, branch statistics).
+  snapshot, branch statistics, state/restore);
+- :mod:`~suspsim.dst.scene` and :mod:`~suspsim.dst.run`: DST scene files and their
+  ``suspsim run`` (the run loop of :mod:`suspsim.run`);
+- :mod:`~suspsim.dst.study`: stress-controlled flow curves.
 """
 from suspsim.dst.parameters import Channel, Geometry, Numerics, StressCouette, WyartCatesFluid
 from suspsim.dst.simulation import DSTSimulation

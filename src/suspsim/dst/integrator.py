@@ -64,8 +64,8 @@ ListArrays = namedtuple("ListArrays", ["start", "neighbours", "cell_of", "order"
 
 
 @njit(**JIT_OPTIONS)
-def _refresh_list(cfg, positions, lists):
-    """Rebuild the list when needed; returns STEP_OK or LIST_OVERFLOW."""
+def refresh_list(cfg, positions, lists):
+    """Rebuild the list when needed (or forced); returns STEP_OK or LIST_OVERFLOW."""
     if lists.force_rebuild[0] == 0 and not needs_rebuild(positions, lists.reference, cfg.lx,
                                                           cfg.skin):
         return STEP_OK
@@ -82,7 +82,7 @@ def _refresh_list(cfg, positions, lists):
 @njit(**JIT_OPTIONS)
 def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
     """Rates at the given state into ``buf`` and wall[WALL_ACCELERATION]; returns a code."""
-    code = _refresh_list(cfg, positions, lists)
+    code = refresh_list(cfg, positions, lists)
     if code != STEP_OK:
         return code
     nf = cfg.n_fluid
@@ -169,9 +169,10 @@ def _check(cfg, positions, velocity, rho, f, wall, eta):
 
 
 @njit(**JIT_OPTIONS)
-def advance_steps(cfg, n_steps, positions, velocity, rho, f, wall, half_positions,
+def advance_steps(cfg, n_steps, t_stop, positions, velocity, rho, f, wall, half_positions,
                   half_velocity, half_rho, half_f, buf, lists, clock):
-    """Advance up to ``n_steps`` predictor–corrector steps; returns (code, steps done).
+    """Advance up to ``n_steps`` predictor–corrector steps, stopping before any step that would
+    start at time >= ``t_stop``; returns (code, steps done).
 
     ``clock`` = [time, last δt] is updated in place. On a nonzero code the state is that after
     the last completed step (a list overflow leaves the current step undone).
@@ -179,6 +180,8 @@ def advance_steps(cfg, n_steps, positions, velocity, rho, f, wall, half_position
     nf = cfg.n_fluid
     n = positions.shape[0]
     for step in range(n_steps):
+        if clock[0] >= t_stop:
+            return STEP_OK, step
         code = evaluate(cfg, positions, velocity, rho, f, wall, buf, lists)
         if code != STEP_OK:
             return code, step

@@ -42,10 +42,11 @@ _MESSAGES = {
     _int.MACH_LIMIT: "Mach number v_max/c exceeds numerics.max_mach: raise numerics.sound_speed "
                      "(now {c:.4g}); if it grew within a few steps, lower "
                      "numerics.viscous_number (unstable step)",
-    _int.JAMMED: "a particle jammed (phi >= phi_J(f)): lower fluid.phi or the imposed stress",
+    _int.JAMMED: "a particle jammed (phi >= phi_J(f)): lower fluid.params.phi or the imposed "
+                 "stress",
     _int.NEAR_JAMMING: "a particle's viscosity exceeds numerics.max_viscosity_ratio * eta_s "
-                       "(approaching jamming, phi -> phi_J(f)): lower fluid.phi or the imposed "
-                       "stress, or raise numerics.max_viscosity_ratio",
+                       "(approaching jamming, phi -> phi_J(f)): lower fluid.params.phi or the "
+                       "imposed stress, or raise numerics.max_viscosity_ratio",
 }
 
 
@@ -176,8 +177,16 @@ class DSTSimulation:
         self._lists = _int.allocate_lists(n, int(1.5 * area * n) + 64)
         self.steps = 0
         self._evaluated = False
+        self._wall_acceleration = 0.0
+        self._turning = None
 
     # ------------------------------------------------------------------ running
+    def _grow_lists(self):
+        """Replace the full neighbour array by one 1.3 times the pairs the last build needed."""
+        need = int(self._lists.start[-1])
+        self._lists = self._lists._replace(
+            neighbours=np.zeros(int(1.3 * need) + 64, dtype=np.int64))
+
     def _run(self, function, *args):
         use_threads(self.threads)
         while True:
@@ -185,34 +194,46 @@ class DSTSimulation:
             code = result[0] if isinstance(result, tuple) else result
             if code != _int.LIST_OVERFLOW:
                 return result
-            need = int(self._lists.start[-1])
-            self._lists = self._lists._replace(
-                neighbours=np.zeros(int(1.3 * need) + 64, dtype=np.int64))
+            self._grow_lists()
             args = tuple(self._lists if isinstance(a, _int.ListArrays) else a for a in args)
 
-    def advance(self, n_steps: int) -> None:
-        """Advance ``n_steps`` predictor–corrector steps; NumericalError on a blow-up."""
+    def advance(self, n_steps: int, until: float | None = None) -> None:
+        """Advance ``n_steps`` predictor–corrector steps, or fewer where a step would start at
+        a time >= ``until`` [s] (so a run can stop on the first step at or past a time, however
+        it splits its calls); NumericalError on a blow-up."""
+        t_stop = math.inf if until is None else float(until)
         remaining = int(n_steps)
         while remaining > 0:
             h_pos, h_vel, h_rho, h_f = self._half
-            code, done = self._run(
-                _int.advance_steps, self.config, remaining, self.positions_all,
-                self.velocity_all, self.rho_all, self.f_all, self.wall, h_pos, h_vel, h_rho,
-                h_f, self._buffers, self._lists, self.clock)
+            use_threads(self.threads)
+            code, done = _int.advance_steps(
+                self.config, remaining, t_stop, self.positions_all, self.velocity_all,
+                self.rho_all, self.f_all, self.wall, h_pos, h_vel, h_rho, h_f, self._buffers,
+                self._lists, self.clock)
             self.steps += done
             remaining -= done
             self._evaluated = False
             if code == _int.LIST_OVERFLOW:
+                self._grow_lists()
                 continue
             if code != _int.STEP_OK:
                 raise NumericalError(f"DST run stopped at step {self.steps}, t = "
                                      f"{self.time:.6g}: "
                                      + _MESSAGES[code].format(c=self.sound_speed))
+            return
 
     def _evaluate(self):
+        """Rates at the current state into the buffers, for diagnostics. The state is left as
+        it was: the wall acceleration, which the next step's wall pass reads, and the dummy
+        densities are restored, so sampling (``snapshot``, ``sample``, ``dt``, ...) never
+        changes the trajectory."""
         if not self._evaluated:
+            wall, dummy_rho = self.wall.copy(), self.rho_all[self.n_fluid:].copy()
             code = self._run(_int.evaluate, self.config, self.positions_all, self.velocity_all,
                              self.rho_all, self.f_all, self.wall, self._buffers, self._lists)
+            self._wall_acceleration = float(self.wall[_int.WALL_ACCELERATION])
+            self.wall[:] = wall
+            self.rho_all[self.n_fluid:] = dummy_rho
             if code != _int.STEP_OK:
                 raise NumericalError(_MESSAGES[code].format(c=self.sound_speed))
             self._evaluated = True
@@ -230,9 +251,63 @@ class DSTSimulation:
         return float(_int.time_step(self.config, self._buffers))
 
     @property
+    def step_count(self) -> int:
+        """Steps taken (the name the run loop of :mod:`suspsim.run` reads)."""
+        return self.steps
+
+    @property
+    def last_dt(self) -> float:
+        """The last step taken [s] (0 before the first); unlike :attr:`dt`, no evaluation."""
+        return float(self.clock[1])
+
+    @property
+    def n_particles(self) -> int:
+        """Fluid and wall particles."""
+        return self.n_fluid + 2 * self.n_wall
+
+    @property
     def wall_velocity(self) -> float:
         """Top-wall velocity V_w [m/s]."""
         return float(self.wall[_int.WALL_VELOCITY])
+
+    def health(self) -> tuple[bool, str]:
+        """Always ``(True, "ok")``: the compiled loop checks every step for blow-up and
+        :meth:`advance` raises NumericalError naming the limit (the run loop's protocol)."""
+        return True, "ok"
+
+    def state(self) -> dict:
+        """Everything :meth:`restore` needs to continue bit for bit: positions, velocities,
+        densities and f of all particles, the wall state [V_w, dV_w/dt], the clock [t, last δt],
+        the step count, and the neighbour list's build positions, staleness and capacity (the
+        list is rebuilt from those, so sums run in the same order)."""
+        lists = self._lists
+        return {"positions": self.positions_all.copy(), "velocity": self.velocity_all.copy(),
+                "density": self.rho_all.copy(), "fraction": self.f_all.copy(),
+                "wall": self.wall.copy(), "clock": self.clock.copy(), "steps": int(self.steps),
+                "list_reference": lists.reference.copy(),
+                "list_stale": int(lists.force_rebuild[0]),
+                "list_capacity": int(lists.neighbours.shape[0])}
+
+    def restore(self, state: dict) -> None:
+        """Continue from :meth:`state` of a run built with the same parameters.
+
+        Raises ValueError when the arrays do not fit this run's particles.
+        """
+        n = self.positions_all.shape[0]
+        for name, target in (("positions", self.positions_all), ("velocity", self.velocity_all),
+                             ("density", self.rho_all), ("fraction", self.f_all),
+                             ("wall", self.wall), ("clock", self.clock)):
+            value = np.asarray(state[name], dtype=float)
+            if value.shape != target.shape:
+                raise ValueError(f"state {name} has shape {value.shape}, this run needs "
+                                 f"{target.shape}")
+            target[...] = value
+        self.steps = int(state["steps"])
+        self._lists = _int.allocate_lists(n, int(state["list_capacity"]))
+        if not int(state["list_stale"]):
+            reference = np.ascontiguousarray(np.asarray(state["list_reference"], dtype=float))
+            self._run(_int.refresh_list, self.config, reference, self._lists)
+        self._evaluated = False
 
     def snapshot(self) -> dict:
         """Per-particle copies of the fluid: x, y [m], v_x, v_y [m/s], rho, f [1], eta [Pa s],
@@ -259,7 +334,7 @@ class DSTSimulation:
                 "velocity_gradient": b.grad[:nf].reshape(nf, 2, 2).copy(),
                 "laplacian_f": b.lap_f[:nf].copy(), "gradient_f": b.grad_f[:nf].copy(),
                 "df_dt": b.df[:nf].copy(), "colour_gradient": b.grad_c[:nf].copy(),
-                "wall_acceleration": float(self.wall[_int.WALL_ACCELERATION])}
+                "wall_acceleration": self._wall_acceleration}
 
     def set_state(self, *, velocity=None, fraction=None, positions=None) -> None:
         """Overwrite fluid velocities (n_f, 2), fractions f (n_f,) or positions (n_f, 2)."""
@@ -275,19 +350,24 @@ class DSTSimulation:
 
     def sample(self) -> dict:
         """Time-series sample: time, wall_velocity, domain-averaged stress σ = ⟨η γ̇⟩,
-        shear_rate ⟨γ̇⟩, fraction ⟨f⟩, wall_shear_rate V_w/L_y and the largest |ρ/ρ0 − 1|."""
+        shear_rate ⟨γ̇⟩, fraction ⟨f⟩, mean_velocity ⟨v_x⟩, wall_shear_rate V_w/L_y, the
+        largest |ρ/ρ0 − 1| (density_error) and the Mach number max |v|/c (mach)."""
         snap = self.snapshot()
+        speed = np.sqrt(snap["v_x"] ** 2 + snap["v_y"] ** 2)
         return {"time": self.time, "wall_velocity": self.wall_velocity,
                 "stress": float(snap["stress"].mean()),
                 "shear_rate": float(snap["shear_rate"].mean()),
                 "fraction": float(snap["f"].mean()),
+                "mean_velocity": float(snap["v_x"].mean()),
                 "wall_shear_rate": self.wall_velocity / self.geometry.gap,
-                "density_error": float(np.max(np.abs(snap["rho"] / self.numerics.density - 1)))}
+                "density_error": float(np.max(np.abs(snap["rho"] / self.numerics.density - 1))),
+                "mach": float(speed.max()) / self.sound_speed}
 
     def profiles(self, bins: int) -> dict:
         """Bin-averaged v_x and f against y over [0, L_y] in ``bins`` equal bins.
 
-        Returns y (bin centres), velocity, fraction, stress and count per bin.
+        Returns y (bin centres), velocity, fraction, stress, shear_rate, viscosity and count
+        per bin (NaN in an empty bin).
         """
         bins = int(bins)
         if bins < 1:
@@ -302,7 +382,9 @@ class DSTSimulation:
             return np.where(count > 0, total / np.maximum(count, 1.0), np.nan)
 
         return {"y": 0.5 * (edges[:-1] + edges[1:]), "velocity": mean(snap["v_x"]),
-                "fraction": mean(snap["f"]), "stress": mean(snap["stress"]), "count": count}
+                "fraction": mean(snap["f"]), "stress": mean(snap["stress"]),
+                "shear_rate": mean(snap["shear_rate"]), "viscosity": mean(snap["eta"]),
+                "count": count}
 
     def branch_statistics(self) -> dict:
         """ψ1 = share of σ_i < σ_β, ψ2 = share of σ_i > σ_α, q = (σ_in − σ_β)/(σ_α − σ_β).
@@ -310,7 +392,7 @@ class DSTSimulation:
         Turning points of the steady law (SPEC §5.6); NaN values when the curve has none.
         q needs the stress-controlled flow (NaN for the channel).
         """
-        turning = None if self.fluid.is_newtonian else self.fluid.steady_law().turning_points()
+        turning = self.turning_points()
         if turning is None or not math.isfinite(turning.sigma_alpha):
             return {"psi1": math.nan, "psi2": math.nan, "q": math.nan}
         sigma = self.snapshot()["stress"]
@@ -319,6 +401,13 @@ class DSTSimulation:
              else math.nan)
         return {"psi1": float(np.mean(sigma < sb)), "psi2": float(np.mean(sigma > sa)),
                 "q": float(q)}
+
+    def turning_points(self):
+        """Turning points of the steady law (computed once), None without (CST, Newtonian)."""
+        if self._turning is None:
+            self._turning = ((None,) if self.fluid.is_newtonian
+                             else (self.fluid.steady_law().turning_points(),))
+        return self._turning[0]
 
     def describe(self) -> dict:
         """Numbers worth logging: particles, h_sl, c, δt and its limits, Reynolds number."""

@@ -32,7 +32,9 @@ FORMAT = "suspsim-checkpoint"
 FORMAT_VERSION = 1
 #: Scene keys that do not change the physics and may differ when a run resumes.
 RESUMABLE_KEYS = (("run", "threads"), ("run", "checkpoint_interval_s"),
-                  ("run", "max_density_error"), ("run", "max_mach"))
+                  ("run", "max_density_error"), ("run", "max_mach"),
+                  ("numerics", "max_density_error"), ("numerics", "max_mach"),
+                  ("numerics", "max_viscosity_ratio"))
 _HEADER = "__suspsim_header__"
 _RESERVED = {_HEADER, "file", "allow_pickle"}
 _SCALARS = {"int": int, "float": float, "bool": bool}

@@ -6,6 +6,7 @@ plus global attributes: ``Conventions``, ``title``, ``source`` (version and git 
 ``history``, ``references``, ``unit_system``, ``scene`` (the complete scene as JSON), ``seed``,
 the provenance of :func:`~suspsim.io.provenance.provenance` and the run attributes of
 :data:`~suspsim.io.variables.RUN_ATTRIBUTES` (``wall_time_s`` and ``completed`` required).
+Another solver's runs (:mod:`suspsim.dst.run`) pass their own :class:`Registry`.
 """
 from __future__ import annotations
 
@@ -13,8 +14,9 @@ import json
 import os
 import shlex
 import sys
+from dataclasses import dataclass
 from datetime import datetime, timezone
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 import xarray as xr
@@ -24,7 +26,7 @@ from .atomic import atomic_path
 from .provenance import provenance
 from .variables import REQUIRED_RUN_ATTRIBUTES, RUN_ATTRIBUTES, UNIT_SYSTEM, VARIABLES
 
-__all__ = ["build_dataset", "provenance", "read_run", "write_run", "REFERENCES"]
+__all__ = ["build_dataset", "provenance", "read_run", "write_run", "Registry", "REFERENCES"]
 
 REFERENCES = (
     "Martys, George, Chun & Lootens, Rheol. Acta 49, 1059-1069 (2010), "
@@ -36,22 +38,43 @@ REFERENCES = (
     "Morris, Fox & Zhu, J. Comput. Phys. 136, 214 (1997) (sound speed, time step)")
 
 
+@dataclass(frozen=True)
+class Registry:
+    """What a run file may hold: ``variables`` (name -> spec with ``dims`` and
+    ``is_coordinate``), ``variable_attrs(spec)`` its netCDF attributes, the global
+    ``attributes`` (name -> :class:`~suspsim.io.variables.Attribute`), ``references`` and
+    ``unit_system`` texts."""
+
+    variables: Mapping[str, Any]
+    variable_attrs: Callable[[Any], dict]
+    attributes: Mapping[str, Any]
+    references: str
+    unit_system: str
+
+
+def sph_registry(dimension: int) -> Registry:
+    """The SPH solver's registry (:mod:`suspsim.io.variables`) for a ``dimension``-D run."""
+    return Registry(VARIABLES, lambda spec: spec.attrs(dimension), RUN_ATTRIBUTES, REFERENCES,
+                    UNIT_SYSTEM)
+
+
 def write_run(path: str | os.PathLike, data: Mapping[str, Any], attrs: Mapping[str, Any],
               scene: Mapping[str, Any], *, command: str | None = None,
-              title: str | None = None) -> None:
+              title: str | None = None, registry: Registry | None = None) -> None:
     """Write one run's results to ``path`` (netCDF4) atomically; see :func:`build_dataset`.
 
     Coordinates get no ``_FillValue`` (CF: coordinate values are never missing); data
     variables use NaN for missing values.
     """
-    dataset = build_dataset(data, attrs, scene, command=command, title=title)
+    dataset = build_dataset(data, attrs, scene, command=command, title=title, registry=registry)
     no_fill = {name: {"_FillValue": None} for name in dataset.coords}
     with atomic_path(path) as tmp:
         dataset.to_netcdf(tmp, engine="netcdf4", encoding=no_fill)
 
 
 def build_dataset(data: Mapping[str, Any], attrs: Mapping[str, Any], scene: Mapping[str, Any], *,
-                  command: str | None = None, title: str | None = None) -> xr.Dataset:
+                  command: str | None = None, title: str | None = None,
+                  registry: Registry | None = None) -> xr.Dataset:
     """The run as an :class:`xarray.Dataset` with registry metadata and global attributes.
 
     Parameters
@@ -62,6 +85,8 @@ def build_dataset(data: Mapping[str, Any], attrs: Mapping[str, Any], scene: Mapp
     scene : the complete scene: a :class:`~suspsim.scene.Scene` or its ``to_dict()``.
     command : the command line for ``history`` (default: this process's ``sys.argv``).
     title : default: a description of the scene's flow and law.
+    registry : the variables and attributes allowed (default: the SPH solver's,
+        :func:`sph_registry`).
 
     Raises
     ------
@@ -69,24 +94,25 @@ def build_dataset(data: Mapping[str, Any], attrs: Mapping[str, Any], scene: Mapp
         dimension without its coordinate, a required attribute missing (programming errors).
     """
     scene = scene.to_dict() if hasattr(scene, "to_dict") else scene
-    dimension = int(scene["dimension"])
-    unknown = sorted(set(data) - set(VARIABLES))
+    registry = registry or sph_registry(int(scene["dimension"]))
+    unknown = sorted(set(data) - set(registry.variables))
     if unknown:
-        raise ValueError(f"variables not in the output registry (suspsim.io.variables): "
-                         f"{', '.join(unknown)}")
+        raise ValueError(f"variables not in the output registry: {', '.join(unknown)}")
     coords, variables = {}, {}
     for name, value in data.items():
-        spec = VARIABLES[name]
+        spec = registry.variables[name]
         array = np.asarray(value, dtype=float)
         if array.ndim != len(spec.dims):
             raise ValueError(f"{name} has {array.ndim} dimension(s); the registry says {spec.dims}")
         target = coords if spec.is_coordinate else variables
-        target[name] = xr.Variable(spec.dims, array, attrs=spec.attrs(dimension))
-    missing = sorted({d for name in variables for d in VARIABLES[name].dims} - set(coords))
+        target[name] = xr.Variable(spec.dims, array, attrs=registry.variable_attrs(spec))
+    missing = sorted({d for name in variables for d in registry.variables[name].dims}
+                     - set(coords))
     if missing:
         raise ValueError(f"dimension(s) {', '.join(missing)} used without their coordinate")
     return xr.Dataset(variables, coords=coords,
-                      attrs=_global_attributes(attrs, scene, command=command, title=title))
+                      attrs=_global_attributes(attrs, scene, registry, command=command,
+                                               title=title))
 
 
 def read_run(path: str | os.PathLike) -> xr.Dataset:
@@ -101,11 +127,10 @@ def read_run(path: str | os.PathLike) -> xr.Dataset:
         raise InputError(path, f"not a readable netCDF run file ({err})") from None
 
 
-def _global_attributes(attrs, scene, *, command, title) -> dict[str, Any]:
-    unknown = sorted(set(attrs) - set(RUN_ATTRIBUTES))
+def _global_attributes(attrs, scene, registry: Registry, *, command, title) -> dict[str, Any]:
+    unknown = sorted(set(attrs) - set(registry.attributes))
     if unknown:
-        raise ValueError(f"run attributes not in the registry (suspsim.io.variables): "
-                         f"{', '.join(unknown)}")
+        raise ValueError(f"run attributes not in the registry: {', '.join(unknown)}")
     missing = [name for name in REQUIRED_RUN_ATTRIBUTES if name not in attrs]
     if missing:
         raise ValueError(f"required run attribute(s) missing: {', '.join(missing)}")
@@ -114,16 +139,17 @@ def _global_attributes(attrs, scene, *, command, title) -> dict[str, Any]:
     command = shlex.join(sys.argv) if command is None else command
     out = {"Conventions": "CF-1.10", "title": title or _default_title(scene),
            "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']})",
-           "history": f"{when}: {command}", "references": REFERENCES,
-           "unit_system": UNIT_SYSTEM, "scene": json.dumps(scene, ensure_ascii=False),
-           "seed": int(scene["seed"]), **prov}
+           "history": f"{when}: {command}", "references": registry.references,
+           "unit_system": registry.unit_system, "scene": json.dumps(scene, ensure_ascii=False),
+           **({"seed": int(scene["seed"])} if "seed" in scene else {}), **prov}
     for name, value in attrs.items():
-        out[name] = _typed_attribute(name, value)
+        out[name] = _typed_attribute(name, value, registry.attributes[name].type)
     return out
 
 
-def _typed_attribute(name: str, value) -> int | float:
-    kind = RUN_ATTRIBUTES[name].type
+def _typed_attribute(name: str, value, kind: type) -> int | float | str:
+    if kind is str:
+        return str(value)
     if isinstance(value, (bool, np.bool_)) or kind is float:
         return kind(value)
     if float(value) != int(value):

@@ -12,7 +12,7 @@ import json
 import math
 import re
 from importlib import resources
-from typing import Any, Mapping
+from typing import Any, Mapping, NoReturn
 
 from jsonschema import Draft202012Validator
 
@@ -37,6 +37,13 @@ def dotted_key(path) -> str:
     for part in path:
         out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
     return out
+
+
+def fail_at(source: str, lines: Mapping[tuple, int], path: tuple, problem: str) -> NoReturn:
+    """Raise :class:`InputError` for the key ``path``, at the line of the nearest enclosing key
+    that has one (``lines`` as from :func:`suspsim.io.yamlfile.load_yaml`)."""
+    line = next((lines[path[:i]] for i in range(len(path), 0, -1) if path[:i] in lines), None)
+    raise InputError(source, problem, line=line, key=dotted_key(path) or None)
 
 
 def validate(data: Any, schema: Mapping, *, source: str, lines: Mapping[tuple, int] | None = None) -> None:

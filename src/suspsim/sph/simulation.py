@@ -115,6 +115,7 @@ class Simulation:
         self._rho_eq = (reference_count or self.n_particles) * self._mass / scene.volume
         self._lubrication = self._lubrication_setup()
         self._shifting = float(scene.numerics.shifting)
+        self._mean_reference = scene.numerics.pressure_reference == "fluid_mean"
         if _state is None:
             self.sound_speed = (float(scene.run.sound_speed) if scene.run.sound_speed is not None
                                 else auto_sound_speed(scene))
@@ -137,6 +138,9 @@ class Simulation:
             self._rebuild(0.0)
             if scene.lattice.relax:
                 self.relax(scene.lattice.relax_tolerance, scene.lattice.relax_max_steps)
+            if self._mean_reference:
+                self._compute_accelerations(self._v, self._a)
+                self._rho_eq = self._fluid_mean_density()
             self._compute_accelerations(self._v, self._a)
             if self.bodies is not None:
                 self.bodies.set_forces(*self._body_forces(self.bodies.rotations()))
@@ -148,6 +152,7 @@ class Simulation:
                 self._lubrication_virial[:] = _state["lubrication_virial"]
             self._relist_from_reference()
             self._members = np.flatnonzero(self._body_of >= 0)
+            self._rho_eq = float(_state.get("rho_eq", self._rho_eq))
         log.info("simulation: %d particles, dt = %.4g, c = %.4g, %d chunk(s) on %d thread(s)",
                  self.n_particles, self.dt, self.sound_speed, self._n_chunks, self.threads)
 
@@ -265,7 +270,7 @@ class Simulation:
     def advance(self, n_steps: int) -> None:
         """Run ``n_steps`` steps in compiled code; Python only rebuilds the neighbour list."""
         use_threads(self.threads)
-        if self.bodies is not None or self._shifting > 0.0:
+        if self.bodies is not None or self._shifting > 0.0 or self._mean_reference:
             self._advance_python(int(n_steps))
             return
         remaining, resume = int(n_steps), False
@@ -334,7 +339,8 @@ class Simulation:
         """The step of :mod:`~suspsim.sph.integrator` with rigid bodies or shifting (module
         docstrings of ``integrator``, ``bodies.system``, ``terms.shifting``): drift fluid and
         bodies, place the body particles, rebuild if needed, predict, place with the predicted
-        body motion, forces, kick both, lubrication, shift."""
+        body motion, forces, kick both, lubrication, shift; with the fluid_mean pressure
+        reference ρ_0 becomes the step's mean fluid density (used from the next step on)."""
         bodies, dt = self.bodies, self.dt
         for _ in range(n_steps):
             time = (self.step_count + 1) * self.dt
@@ -367,6 +373,8 @@ class Simulation:
                 shift_particles(self._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
                                 self._volume, self._body_of, self._shifting, self._rate, dt,
                                 SUPPORT, self._gradient, self._grad_c, self._x, self._v)
+            if self._mean_reference:
+                self._rho_eq = self._fluid_mean_density()
             self.step_count += 1
 
     def relax(self, tolerance: float, max_steps: int) -> int:
@@ -440,6 +448,11 @@ class Simulation:
         out[:, 0] -= imposed_velocity(self.scene, self._x[:, 1])
         return out
 
+    def _fluid_mean_density(self) -> float:
+        """Mean summation density of the fluid particles [m h^-d] (body shells excluded)."""
+        n_fluid = self.n_particles - self._members.shape[0]
+        return float((np.sum(self._rho) - np.sum(self._rho[self._members])) / n_fluid)
+
     def _density_error(self) -> float:
         """max |ρ/ρ_eq − 1| over the fluid particles (a rigid body's particles cannot follow)."""
         rho = self._rho if self.bodies is None else self._rho[self._body_of < 0]
@@ -509,7 +522,7 @@ class Simulation:
         out = {name: getattr(self, attribute).copy() for name, attribute in _STATE_ARRAYS.items()}
         out.update(time=self.time, step_count=self.step_count, dt=self.dt,
                    sound_speed=self.sound_speed, build_time=self._build_time,
-                   n_chunks=self._n_chunks)
+                   n_chunks=self._n_chunks, rho_eq=self._rho_eq)
         if self.bodies is not None:
             out.update(bodies=self.bodies.state(), body_volume=self._body_volume,
                        body_radii=self._body_radii.copy(),

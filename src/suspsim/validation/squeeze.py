@@ -284,6 +284,9 @@ def _two_sphere_scene(box, radius, centres, viscosity, sound_speed, workdir, *,
         "fluid": {"law": "newtonian", "params": {"mu": float(viscosity)}},
         "flow": {"type": "couette", "shear_rate": 1e-9},
         "run": {"time": 1.0, "start": "rest", "sound_speed": float(sound_speed)},
+        # Shifting scales with the imposed shear rate, here none: off, with the lattice's
+        # reference density (a zero mean pressure without shifting lets particles pair up).
+        "numerics": {"shifting": 0.0, "pressure_reference": "nominal"},
         "inclusions": {"packing": str(path)}})
 
 
