@@ -164,3 +164,50 @@ def test_turning_points_bracket_negative_slope(model):
     assert model.shear_rate(mid) <= points.gdot_max
     assert model.log_slope(mid) < 0
     assert model.regime() == (DST if model.phi < model.phi_m else JAMMED_AT_HIGH_STRESS)
+
+
+@pytest.mark.parametrize("phi", [0.50, 0.54])
+def test_branch_stress_inverts_the_stable_branches(phi):
+    """σ1 < σ_β and σ2 > σ_α solve γ̇(σ) = rate on the stable branches, for rates in
+    (γ̇_min, γ̇_max); NaN outside each branch's range."""
+    model = seed_model(phi)
+    tp = model.turning_points()
+    rates = np.linspace(tp.gdot_min, tp.gdot_max, 7)[1:-1]
+    low, high = model.branch_stress(rates, "lower"), model.branch_stress(rates, "upper")
+    assert np.all(low < tp.sigma_beta) and np.all(high > tp.sigma_alpha)
+    np.testing.assert_allclose(model.shear_rate(low), rates, rtol=1e-12)
+    np.testing.assert_allclose(model.shear_rate(high), rates, rtol=1e-12)
+    assert np.all(model.log_slope(low) > 0) and np.all(model.log_slope(high) > 0)
+    assert math.isnan(model.branch_stress(1.01 * tp.gdot_max, "lower"))
+    assert math.isnan(model.branch_stress(0.99 * tp.gdot_min, "upper"))
+    assert model.branch_stress(0.5 * tp.gdot_min, "lower") < tp.sigma_beta
+    assert model.branch_stress(2.0 * tp.gdot_max, "upper") > tp.sigma_alpha
+    with pytest.raises(ValueError):
+        model.branch_stress(rates, "middle")
+
+
+def test_branch_stress_without_turning_points_and_jammed():
+    """CST: both branches are the single root; φ ≥ φ_m: no flowing upper branch."""
+    cst = seed_model(0.48)
+    rate = float(cst.shear_rate(3e-3))
+    assert cst.branch_stress(rate, "lower") == pytest.approx(3e-3, rel=1e-12)
+    assert cst.branch_stress(rate, "upper") == pytest.approx(3e-3, rel=1e-12)
+    assert math.isnan(cst.lever_rule(3e-3, rate))
+    jammed = seed_model(0.57)
+    assert math.isnan(jammed.branch_stress(0.5 * jammed.turning_points().gdot_max, "upper"))
+
+
+def test_lever_rule_conserves_the_mean_stress():
+    """ψ1 σ1 + (1 − ψ1) σ2 = σ_in at the given rate; ψ1 → 1 at σ_in = σ1, 0 at σ2."""
+    model = seed_model(0.54)
+    tp = model.turning_points()
+    sigma = np.linspace(tp.sigma_beta, tp.sigma_alpha, 6)[1:-1]
+    rate = model.shear_rate(sigma)
+    psi1 = model.lever_rule(sigma, rate)
+    s1, s2 = model.branch_stress(rate, "lower"), model.branch_stress(rate, "upper")
+    np.testing.assert_allclose(psi1 * s1 + (1 - psi1) * s2, sigma, rtol=1e-12)
+    assert np.all((psi1 > 0) & (psi1 < 1))
+    assert np.all(np.diff(psi1) < 0)  # more stress, more particles on the upper branch
+    g = float(rate[1])
+    assert model.lever_rule(model.branch_stress(g, "lower"), g) == pytest.approx(1.0)
+    assert model.lever_rule(model.branch_stress(g, "upper"), g) == pytest.approx(0.0, abs=1e-12)

@@ -30,7 +30,7 @@ import pytest
 
 from suspsim.dst import (Channel, DSTSimulation, Geometry, Numerics, StressCouette,
                          WyartCatesFluid)
-from suspsim.dst.study import STRONG_NONLOCALITY, flow_curve
+from suspsim.dst.study import LOCAL, STRONG_NONLOCALITY, flow_curve, stress_splitting
 from suspsim.reference.dst_channel import dst_channel_mean_velocity, dst_channel_profile
 
 pytestmark = pytest.mark.slow
@@ -193,3 +193,68 @@ def test_strong_nonlocality_flow_curve_point(phi, stress):
     assert wall_rate == pytest.approx(rate, rel=0.05)
     assert sigma == pytest.approx(stress, rel=0.05)
     assert float(law.shear_rate(sigma)) == pytest.approx(gdot, rel=0.05)
+
+
+#: Zero non-locality: imposed stress, lattice and strains (γ̇_WC t) of the splitting test.
+SPLIT_STRESS = 2.0
+SPLIT_RUN = (dict(lattice=(N_X, 10), equilibration_strain=15.0, averaging_strain=10.0,
+                  samples=16, n_blocks=8) if REDUCED else
+             dict(lattice=(N_X, 12), equilibration_strain=20.0, averaging_strain=20.0,
+                  samples=40, n_blocks=8))
+
+
+@pytest.fixture(scope="module")
+def split_run():
+    """One zero-non-locality run (α = 0, φ = 0.54, σ_in = 2σ*) shared by the two tests below."""
+    start = time.perf_counter()
+    data = stress_splitting(0.54, [SPLIT_STRESS], alpha=LOCAL, threads=THREADS, **SPLIT_RUN)
+    return data, time.perf_counter() - start
+
+
+def test_zero_nonlocality_splits_onto_both_branches(split_run):
+    """α = 0, φ = 0.54, σ_in = 2σ* (q = 0.39, on the unstable branch): stress splitting.
+
+    :func:`suspsim.dst.study.stress_splitting` starts at f̂(σ_in) with a 1 % uncorrelated
+    perturbation and discards 20 strain units (15 reduced) — the split starts after ≈ 3 and
+    settles after ≈ 10 — then averages over 20 (10). Checks (SPEC §5.6; seed 002 Fig. 5):
+
+    * both stable branches are populated: ψ1 > 0.3 and ψ2 > 0.1 (the lever rule expects
+      ≈ 0.7 / 0.3), and ψ1 + ψ2 > 0.9 (particles off the branches are in transit);
+    * as in the seed, the shear rate drops below γ̇_WC(σ_in) and ψ1 lies below the lever rule
+      evaluated at γ̇_WC (the Fig. 5 line) by more than 3 standard errors.
+    """
+    data, wall = split_run
+    p = {k: float(v) for k, v in data.isel(stress=0).data_vars.items()}
+    n_x, n_y = SPLIT_RUN["lattice"]
+    print(f"\n[DST splitting sigma={SPLIT_STRESS:g} n={n_x}x{n_y}] {int(p['steps'])} steps, "
+          f"wall {wall:.1f} s, {data.attrs['n_particles'] * p['steps'] / wall:.3g} "
+          f"particle-steps/s")
+    print(f"  q {p['q']:.3f}: psi1 {p['psi1']:.3f} +- {p['psi1_stderr']:.3f}, psi2 "
+          f"{p['psi2']:.3f} +- {p['psi2_stderr']:.3f}, sum {p['psi_sum']:.3f}; lever(V_w/L_y) "
+          f"{p['lever_rule']:.3f}, lever(<gdot>) {p['lever_rule_domain_rate']:.3f}, "
+          f"lever(gdot_WC) {p['wyart_cates_lever_rule']:.3f}; psi1 - lever "
+          f"{p['psi1_minus_lever']:+.3f} +- {p['psi1_minus_lever_stderr']:.3f}; V_w/L_y/gdot_WC "
+          f"{p['wall_shear_rate'] / p['wyart_cates_shear_rate']:.3f}, <sigma>/sigma_in "
+          f"{p['measured_stress'] / SPLIT_STRESS:.3f}")
+    assert p["psi1"] > 0.3 and p["psi2"] > 0.1
+    assert p["psi_sum"] > 0.9
+    assert p["wall_shear_rate"] < p["wyart_cates_shear_rate"]
+    assert p["psi1"] < p["wyart_cates_lever_rule"] - 3.0 * p["psi1_stderr"]
+
+
+@pytest.mark.xfail(not REDUCED, strict=True, reason=(
+    "measured (14x12, strains 20-40): psi1 0.649 +- 0.002 vs lever rule at V_w/L_y 0.683; "
+    "<psi1 - lever> = -0.031 +- 0.0053 (batch means), tolerance 3 se + 1 particle = 0.022. "
+    "Reduced (14x10, strains 15-25): -0.020 +- 0.006 < 0.025 passes. psi1 still creeps up "
+    "(0.64 at strain 20, 0.69 at 60), so the offset may be the unfinished drift; not resolved"))
+def test_zero_nonlocality_split_follows_the_lever_rule(split_run):
+    """ψ1 agrees with the vertical-split lever rule at the measured common rate V_w/L_y:
+    |⟨ψ1 − lever(V_w/L_y)⟩| < 3 standard errors (batch means of the per-sample difference, so
+    the fluctuations of V_w that move the prediction are in the error) + one particle."""
+    data, _ = split_run
+    p = {k: float(v) for k, v in data.isel(stress=0).data_vars.items()}
+    n_x, n_y = SPLIT_RUN["lattice"]
+    tolerance = 3.0 * p["psi1_minus_lever_stderr"] + 1.0 / (n_x * n_y)
+    print(f"\n  psi1 - lever {p['psi1_minus_lever']:+.4f} +- {p['psi1_minus_lever_stderr']:.4f}"
+          f", tolerance {tolerance:.4f}")
+    assert abs(p["psi1_minus_lever"]) < tolerance

@@ -252,8 +252,8 @@ def flow_curve_dataset(fluid: WyartCatesFluid, geometry: Geometry, stresses, rec
     return dataset
 
 
-def _attrs(name: str) -> dict[str, str]:
-    long_name, scaled, comment = FLOW_CURVE_VARIABLES[name]
+def _attrs(name: str, table: dict | None = None) -> dict[str, str]:
+    long_name, scaled, comment = (FLOW_CURVE_VARIABLES if table is None else table)[name]
     out = {"units": _PHYSICAL_UNITS.get(name, "1"), "long_name": long_name}
     if scaled:
         out["simulation_units"] = scaled
@@ -285,3 +285,197 @@ def spanning_stresses(fluid: WyartCatesFluid, count: int = 13, *, low: float = 0
     return np.concatenate([np.geomspace(low, sb, below + 1)[:-1],
                            np.geomspace(sb, sa, inside + 2)[1:-1],
                            np.geomspace(sa, high, above + 1)[1:]])
+
+
+# --------------------------------------------------------------------------- stress splitting
+#: name -> (long_name, simulation_units or None, comment or None) of :func:`stress_splitting`.
+SPLITTING_VARIABLES = {
+    "stress": ("imposed shear stress sigma_in on the top wall", _STRESS, None),
+    "q": ("stress coordinate q = (sigma_in - sigma_beta)/(sigma_alpha - sigma_beta)", None,
+          "0 < q < 1 on the unstable branch"),
+    "psi1": ("time-averaged share of particles with sigma_i < sigma_beta", None, None),
+    "psi1_stderr": ("standard error of psi1 (batch means)", None, None),
+    "psi2": ("time-averaged share of particles with sigma_i > sigma_alpha", None, None),
+    "psi2_stderr": ("standard error of psi2 (batch means)", None, None),
+    "psi_sum": ("psi1 + psi2, share of particles on a stable branch", None, None),
+    "wall_shear_rate": ("time-averaged top-wall velocity over the gap V_w/L_y", _RATE, None),
+    "wall_shear_rate_stderr": ("standard error of wall_shear_rate (batch means)", _RATE, None),
+    "shear_rate": ("domain- and time-averaged shear-rate magnitude <sqrt(2 D:D)>", _RATE, None),
+    "shear_rate_stderr": ("standard error of shear_rate (batch means)", _RATE, None),
+    "measured_stress": ("domain- and time-averaged stress <eta gdot>", _STRESS, None),
+    "measured_stress_stderr": ("standard error of measured_stress (batch means)", _STRESS, None),
+    "frictional_fraction": ("domain- and time-averaged fraction of frictional contacts <f>",
+                            None, None),
+    "lower_branch_stress": ("sigma1, lower stable branch stress at wall_shear_rate", _STRESS,
+                            "NaN where the branch has no such rate"),
+    "upper_branch_stress": ("sigma2, upper stable branch stress at wall_shear_rate", _STRESS,
+                            "NaN where the branch has no such rate"),
+    "lever_rule": ("lever-rule share (sigma2 - sigma_in)/(sigma2 - sigma1) at wall_shear_rate",
+                   None, "the prediction for psi1 at the measured common rate"),
+    "lever_rule_domain_rate": ("lever-rule share at the domain-averaged rate shear_rate", None,
+                               None),
+    "psi1_minus_lever": ("time average of psi1 - lever rule at the instantaneous V_w/L_y", None,
+                         None),
+    "psi1_minus_lever_stderr": ("standard error of psi1_minus_lever (batch means)", None,
+                                "the statistical error of the lever-rule comparison"),
+    "wyart_cates_shear_rate": ("steady Wyart-Cates shear rate at sigma_in", _RATE, None),
+    "wyart_cates_lever_rule": ("lever-rule share at the Wyart-Cates rate gdot(sigma_in) "
+                               "(seed 002 Fig. 5 line)", None, None),
+    "initial_perturbation": ("rms of the random perturbation added to f = f_hat(sigma_in)",
+                             None, None),
+    "density": ("reference density rho0 of the run", "sigma_star L_y2 eta_s-2", None),
+    "sound_speed": ("artificial sound speed", "sigma_star L_y eta_s-1", None),
+    "steps": ("predictor-corrector steps of the run", None, None),
+    "simulated_time": ("simulated time at the end of the run", "eta_s sigma_star-1", None),
+    "wall_time": ("wall-clock time of the run (set-up and stepping)", None, None),
+}
+
+
+def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
+                     lattice: tuple[int, int] = (14, 12), threads: int = 1,
+                     epsilon: float = 0.1, perturbation: float = 0.01, seed: int = 1,
+                     equilibration_strain: float = 20.0, averaging_strain: float = 20.0,
+                     samples: int = 40, n_blocks: int = 8,
+                     phi_m: float = SEED_002["phi_m"], phi_0: float = SEED_002["phi_0"],
+                     beta: float = SEED_002["beta"], K_f: float = SEED_002["K_f"]
+                     ) -> xr.Dataset:
+    """Stress splitting of the local model (SPEC §5.6; seed 002 Fig. 5): one run per stress.
+
+    Set-up as :func:`flow_curve` (scaled units, ρ from ε = K_f γ̇ ρ L_y²/η at the Wyart–Cates
+    rate γ̇_WC(σ_in)), with three differences:
+
+    * **Start**: f_i = f̂(σ_in) + ``perturbation`` · N(0, 1) per particle (clipped to [0, 1],
+      generator ``seed``), V_w = γ̇_WC L_y. The homogeneous fixed point on the unstable branch
+      is unstable to particle-scale perturbations at α = 0 (a particle with more contacts
+      carries more stress at the common rate, so f̂(σ_i) rises: the rate-controlled slope is
+      negative there); seed 002 seeds it with the uncorrelated SPH noise of γ̇_i and finds the
+      same steady split from relaxed, steady and over-structured starts. On the regular
+      lattice in affine shear (corrected gradients are exact for linear fields) that noise
+      starts near round-off, so an explicit uncorrelated perturbation of 1 % (≈ 1.3 % of f̂
+      at σ_in = 2σ*) stands for it [choice]; it starts the split within ≈ 3 strain units
+      (measured at φ = 0.54, σ_in = 2σ*, 14 × 12).
+    * **Sound speed**: c = max(Morris, sqrt(σ2/(ρ δ))) with σ2 the upper-branch stress at
+      γ̇_WC, the largest stress a split particle carries (δ = 1 %). With the Morris value from
+      σ_in the density error passed 5 % at strain 13 of the split (measured, 14 × 20, σ_in = 2).
+    * **Time**: at σ_in = 2σ* (14 × 12, measured) the split starts after ≈ 3 strain units
+      (γ̇_WC t), ψ1 reaches 0.61 by 10 and then creeps (0.64 at 20, 0.69 at 60) while the
+      rate settles ≈ 20 % below γ̇_WC; the window is therefore not free of a slow drift,
+      which the batch-means errors (blocks of 2.5 strain units) do not include;
+      ``equilibration_strain`` (default 20) is discarded, then ``samples`` equally spaced
+      samples over ``averaging_strain`` (default 20) give ψ1, ψ2, V_w/L_y, ⟨γ̇⟩, ⟨σ⟩ and the
+      lever rule at each sample's V_w/L_y, with batch-means errors over ``n_blocks`` blocks.
+      The runs advance by simulated time (the step shrinks as particles reach the viscous
+      upper branch).
+
+    The lever rule (SPEC §5.6) is evaluated at the measured common rate, the time-averaged
+    V_w/L_y (``lever_rule``; also at ⟨γ̇⟩, ``lever_rule_domain_rate``), with σ1, σ2 from
+    :meth:`~suspsim.rheology.wyart_cates.WyartCates.branch_stress`; ``wyart_cates_lever_rule``
+    is the seed's Fig. 5 line at γ̇_WC(σ_in). ``psi1_minus_lever`` is the time average of
+    ψ1(t) − lever(V_w(t)/L_y), whose batch-means error is the statistical error of the
+    comparison (fluctuations of V_w move both).
+
+    Returns a Dataset on ``stress`` (variables :data:`SPLITTING_VARIABLES`, attributes as
+    :func:`flow_curve_dataset`). Raises InputError for stresses outside (σ_β, σ_α) or a law
+    without turning points.
+    """
+    stresses = np.atleast_1d(np.asarray(stresses, dtype=float))
+    fluid = WyartCatesFluid(eta_s=1.0, phi=phi, phi_m=phi_m, phi_0=phi_0, sigma_star=1.0,
+                            beta=beta, K_f=K_f, alpha=alpha)
+    law = fluid.steady_law()
+    turning = law.turning_points()
+    if turning is None or not math.isfinite(turning.sigma_alpha):
+        raise InputError("stress_splitting", f"phi = {phi} has no unstable branch with a "
+                         "flowing upper branch (need DST, phi < phi_m)", key="phi")
+    if stresses.ndim != 1 or stresses.size == 0 or np.any(
+            ~((stresses > turning.sigma_beta) & (stresses < turning.sigma_alpha))):
+        raise InputError("stress_splitting", f"stresses {stresses.tolist()} must lie inside "
+                         f"the unstable range ({turning.sigma_beta:.4g}, "
+                         f"{turning.sigma_alpha:.4g})", key="stresses")
+    if int(samples) != samples or int(n_blocks) != n_blocks or n_blocks < 2 \
+            or samples % n_blocks:
+        raise InputError("stress_splitting", f"samples = {samples} must be a multiple of "
+                         f"n_blocks = {n_blocks} >= 2", key="samples")
+    geometry = Geometry(int(lattice[0]), int(lattice[1]), 1.0)
+    settings = {"epsilon": float(epsilon), "perturbation": float(perturbation),
+                "seed": int(seed), "equilibration_strain": float(equilibration_strain),
+                "averaging_strain": float(averaging_strain), "samples": int(samples),
+                "n_blocks": int(n_blocks), "threads": int(threads)}
+    records = [_split_point(fluid, law, geometry, float(s), **settings) for s in stresses]
+    data = {}
+    for name in SPLITTING_VARIABLES:
+        if name == "stress":
+            continue
+        values = np.array([float(r[name]) for r in records])
+        if name == "steps":
+            values = values.astype(np.int64)
+        data[name] = ("stress", values, _attrs(name, SPLITTING_VARIABLES))
+    dataset = xr.Dataset(data, coords={"stress": ("stress", stresses,
+                                                  _attrs("stress", SPLITTING_VARIABLES))})
+    base = flow_curve_dataset(fluid, geometry, stresses, [{"steps": 0} for _ in stresses],
+                              settings)
+    dataset.attrs = {**base.attrs,
+                     "title": f"Stress splitting of the local Wyart-Cates model in 2D SPH "
+                              f"stress-controlled shear, phi = {phi:g}, alpha = {alpha:g}",
+                     "source": base.attrs["source"].replace("flow_curve", "stress_splitting"),
+                     "n_particles": int(records[0]["n_particles"]),
+                     "wall_time_s": float(sum(r["wall_time"] for r in records))}
+    return dataset
+
+
+def _split_point(fluid, law, geometry, stress, *, epsilon, perturbation, seed,
+                 equilibration_strain, averaging_strain, samples, n_blocks, threads) -> dict:
+    """One split run; the record of :func:`stress_splitting`."""
+    start = wallclock.perf_counter()
+    turning = law.turning_points()
+    rate = fluid.shear_rate(stress)
+    density = epsilon * stress / (fluid.K_f * rate ** 2)
+    upper = float(law.branch_stress(rate, "upper"))
+    morris = max(10.0 * rate * geometry.gap, math.sqrt(stress / (density * 0.01)))
+    sound = max(morris, math.sqrt(upper / (density * 0.01)))
+    sim = DSTSimulation(fluid, StressCouette(stress), geometry,
+                        Numerics(density=density, sound_speed=sound), threads=threads)
+    rng = np.random.default_rng(seed)
+    f0 = fluid.frictional_fraction(stress)
+    sim.set_state(fraction=np.clip(f0 + perturbation * rng.standard_normal(sim.n_fluid),
+                                   0.0, 1.0))
+    t_eq = equilibration_strain / rate
+    sim.advance(2 ** 62, until=t_eq)
+    series = {k: [] for k in ("psi1", "psi2", "wall", "rate", "stress", "f", "diff")}
+    for k in range(samples):
+        sim.advance(2 ** 62, until=t_eq + (k + 1) * averaging_strain / rate / samples)
+        sample, branches = sim.sample(), sim.branch_statistics()
+        series["psi1"].append(branches["psi1"])
+        series["psi2"].append(branches["psi2"])
+        series["wall"].append(sample["wall_shear_rate"])
+        series["rate"].append(sample["shear_rate"])
+        series["stress"].append(sample["stress"])
+        series["f"].append(sample["fraction"])
+        series["diff"].append(branches["psi1"]
+                              - float(law.lever_rule(stress, sample["wall_shear_rate"])))
+    est = {k: batch_means(v, n_blocks) for k, v in series.items()}
+    wall_rate = est["wall"].mean
+    record = {
+        "q": (stress - turning.sigma_beta) / (turning.sigma_alpha - turning.sigma_beta),
+        "psi1": est["psi1"].mean, "psi1_stderr": est["psi1"].stderr,
+        "psi2": est["psi2"].mean, "psi2_stderr": est["psi2"].stderr,
+        "psi_sum": est["psi1"].mean + est["psi2"].mean,
+        "wall_shear_rate": wall_rate, "wall_shear_rate_stderr": est["wall"].stderr,
+        "shear_rate": est["rate"].mean, "shear_rate_stderr": est["rate"].stderr,
+        "measured_stress": est["stress"].mean, "measured_stress_stderr": est["stress"].stderr,
+        "frictional_fraction": est["f"].mean,
+        "lower_branch_stress": float(law.branch_stress(wall_rate, "lower")),
+        "upper_branch_stress": float(law.branch_stress(wall_rate, "upper")),
+        "lever_rule": float(law.lever_rule(stress, wall_rate)),
+        "lever_rule_domain_rate": float(law.lever_rule(stress, est["rate"].mean)),
+        "psi1_minus_lever": est["diff"].mean, "psi1_minus_lever_stderr": est["diff"].stderr,
+        "wyart_cates_shear_rate": rate,
+        "wyart_cates_lever_rule": float(law.lever_rule(stress, rate)),
+        "initial_perturbation": perturbation, "density": density, "sound_speed": sound,
+        "steps": sim.steps, "simulated_time": sim.time, "n_particles": sim.n_particles,
+        "wall_time": wallclock.perf_counter() - start}
+    log.info("phi %g sigma_in %.4g (q %.3f): psi1 %.3f +- %.3f, psi2 %.3f, lever %.3f "
+             "(WC %.3f), V_w/L_y/gdot_WC %.3f, %d steps, %.0f s", fluid.phi, stress,
+             record["q"], record["psi1"], record["psi1_stderr"], record["psi2"],
+             record["lever_rule"], record["wyart_cates_lever_rule"], wall_rate / rate,
+             sim.steps, record["wall_time"])
+    return record

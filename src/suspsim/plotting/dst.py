@@ -97,3 +97,42 @@ def plot_flow_curves(datasets, *, labels=None, residuals: bool = True) -> Figure
 def _values(data: xr.Dataset, name: str) -> np.ndarray | None:
     """The variable's values, or None (no error bars) when the Dataset lacks it."""
     return data[name].values if name in data else None
+
+
+def plot_branch_split(data: xr.Dataset) -> Figure:
+    """Branch shares ψ1 (circles) and ψ2 (triangles) against q, with the lever rule (Fig. 5).
+
+    ``data``: output of :func:`suspsim.dst.study.stress_splitting`. Lines: the vertical-split
+    lever rule at the Wyart–Cates rate γ̇_WC(σ_in) (seed 002's Fig. 5 prediction), ψ1 solid
+    and ψ2 = 1 − ψ1 dashed, drawn over 0 < q < 1. Open squares: the lever rule at the measured
+    common rate V_w/L_y of each run. Markers with batch-means error bars: the measured ψ1, ψ2;
+    crosses: ψ1 + ψ2. No file I/O.
+    """
+    law = steady_law(data)
+    turning = law.turning_points()
+    sb, sa = turning.sigma_beta, turning.sigma_alpha
+    q_line = np.linspace(0.005, 0.995, CURVE_POINTS)
+    sigma = sb + q_line * (sa - sb)
+    lever = np.asarray(law.lever_rule(sigma, np.asarray(law.shear_rate(sigma))), dtype=float)
+    fig = Figure(figsize=(6.4, 4.8), layout="constrained")
+    ax = fig.subplots()
+    ax.plot(q_line, lever, "k-", lw=1.2, label="lever rule at γ̇_WC(σ_in): ψ1")
+    ax.plot(q_line, 1.0 - lever, "k--", lw=1.2, label="lever rule at γ̇_WC(σ_in): ψ2 = 1 − ψ1")
+    q = data["q"].values
+    ax.plot(q, data["lever_rule"].values, "s", ms=7, mfc="none", mec="tab:red",
+            label="lever rule at measured V_w/L_y: ψ1")
+    ax.errorbar(q, data["psi1"].values, yerr=_values(data, "psi1_stderr"), fmt="o",
+                color="k", ms=5, capsize=2, label="SPH ψ1 (σ_i < σ_β)")
+    ax.errorbar(q, data["psi2"].values, yerr=_values(data, "psi2_stderr"), fmt="^",
+                color="k", ms=5, capsize=2, label="SPH ψ2 (σ_i > σ_α)")
+    ax.plot(q, data["psi_sum"].values, "x", color="0.4", ms=6, label="SPH ψ1 + ψ2")
+    ax.set_xlim(0.0, 1.0)
+    ax.set_ylim(0.0, 1.05)
+    ax.set_xlabel("q = (σ_in − σ_β)/(σ_α − σ_β) [1]")
+    ax.set_ylabel("branch share [1]")
+    a = data.attrs
+    ax.set_title(f"Stress splitting, local model (α = {a['alpha']:g}), φ = {a['phi']:.2f}, "
+                 f"{a['n_x']} × {a['n_y']} particles", fontsize="medium")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small", loc="center left")
+    return fig

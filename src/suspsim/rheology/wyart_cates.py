@@ -222,6 +222,58 @@ class WyartCates:
         sigma_beta = self._stress(x_beta)
         return TurningPoints(sigma_beta, float(self.shear_rate(sigma_beta)), sigma_alpha, gdot_min)
 
+    def branch_stress(self, rate, branch):
+        """Stress σ [Pa] of a stable branch of the S-curve at shear rate ``rate`` [1/s].
+
+        ``branch = "lower"``: the root of γ̇(σ) = rate with σ < σ_β (γ̇ rises from 0 to
+        γ̇_max there), NaN where rate ≥ γ̇_max; ``"upper"``: the root with σ > σ_α (γ̇ rises
+        from γ̇_min to ∞ for φ < φ_m), NaN where rate ≤ γ̇_min and always NaN for φ ≥ φ_m (no
+        flowing upper branch). Without turning points (CST) γ̇(σ) is monotone and both branches
+        are the whole curve, so both return its single root. These are σ1, σ2 of the vertical-
+        split lever rule (SPEC §5.6); rate may be an array (elementwise).
+        """
+        if branch not in ("lower", "upper"):
+            raise ValueError(f"branch must be 'lower' or 'upper', got {branch!r}")
+        rates = np.asarray(rate, dtype=float)
+        if np.any(~(rates > 0.0)):
+            raise ValueError("branch_stress needs rate > 0 1/s")
+        turning = self.turning_points()
+        out = np.array([self._branch_root(float(g), branch, turning) for g in rates.ravel()])
+        return out.reshape(rates.shape)[()]
+
+    def _branch_root(self, rate, branch, turning):
+        def residual(s):
+            return float(self.shear_rate(s)) - rate
+
+        if turning is None:
+            low, high = 0.0, self.sigma_star
+        elif branch == "lower":
+            if rate >= turning.gdot_max:
+                return math.nan
+            low, high = 0.0, turning.sigma_beta
+        else:
+            # φ ≥ φ_m: σ_α is the jamming stress, γ̇ = 0 beyond it (no flowing upper branch)
+            if self.phi >= self.phi_m or rate <= turning.gdot_min:
+                return math.nan
+            low, high = turning.sigma_alpha, 2.0 * turning.sigma_alpha
+        # γ̇ is increasing on the bracket and unbounded above it (stable branches, CST).
+        while residual(high) < 0.0:
+            low, high = high, 2.0 * high
+        return brentq(residual, low, high, **_BRENT)
+
+    def lever_rule(self, stress, rate):
+        """Lower-branch share ψ1 = (σ2 − σ)/(σ2 − σ1) of a vertical split of σ at rate γ̇.
+
+        σ1, σ2 = :meth:`branch_stress` (lower, upper) at ``rate`` (SPEC §5.6). NaN where
+        either branch lacks that rate (γ̇ outside (γ̇_min, γ̇_max)) or the curve is CST. The
+        share lies in [0, 1] only for σ1 ≤ σ ≤ σ2; it is returned unclipped.
+        """
+        if self.turning_points() is None:
+            return np.full(np.shape(stress), math.nan)[()]
+        s1 = np.asarray(self.branch_stress(rate, "lower"))
+        s2 = np.asarray(self.branch_stress(rate, "upper"))
+        return ((s2 - np.asarray(stress, dtype=float)) / (s2 - s1))[()]
+
     def regime(self):
         """``"CST"``, ``"DST"`` or ``"jammed_at_high_stress"`` (see the module docstring)."""
         if self.phi >= self.phi_m:

@@ -109,3 +109,31 @@ def test_plot_flow_curves_draws_points_curves_and_turning_points():
     fig.savefig(io.BytesIO(), format="png")
     single = plot_flow_curves(datasets[2], residuals=False)
     assert len(single.axes) == 1
+
+
+def test_branch_split_figure_and_input_checks():
+    """plot_branch_split draws a synthetic stress_splitting Dataset; stresses outside the
+    unstable range and a CST φ are rejected before any run."""
+    from suspsim.dst.study import SPLITTING_VARIABLES, stress_splitting
+    from suspsim.plotting.dst import plot_branch_split
+
+    f = fluid(0.54)
+    law = f.steady_law()
+    tp = law.turning_points()
+    stresses = np.array([1.2, 2.0, 3.0])
+    rate = 0.8 * law.shear_rate(stresses)
+    lever = law.lever_rule(stresses, rate)
+    values = {name: np.full(3, 0.01) for name in SPLITTING_VARIABLES if name != "stress"}
+    values.update(q=(stresses - tp.sigma_beta) / (tp.sigma_alpha - tp.sigma_beta),
+                  psi1=lever, psi2=1 - lever - 0.02, psi_sum=np.full(3, 0.98),
+                  lever_rule=lever)
+    base = synthetic(0.54)
+    data = xr.Dataset({k: ("stress", v) for k, v in values.items()},
+                      coords={"stress": stresses}, attrs=base.attrs)
+    fig = plot_branch_split(data)
+    assert isinstance(fig, Figure)
+    fig.savefig(io.BytesIO(), format="png")
+    with pytest.raises(InputError):
+        stress_splitting(0.54, [0.5])
+    with pytest.raises(InputError):
+        stress_splitting(0.48, [1.0])
