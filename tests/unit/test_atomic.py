@@ -31,3 +31,12 @@ def test_failure_keeps_previous_output(tmp_path):
             tmp.write_text("new, half")
             raise ValueError
     assert target.read_text() == "old" and len(list(tmp_path.iterdir())) == 1
+
+
+def test_output_gets_the_permissions_of_a_plain_file(tmp_path):
+    plain = tmp_path / "plain.txt"
+    plain.write_text("x")
+    target = tmp_path / "out.txt"
+    with atomic_path(target) as tmp:
+        tmp.write_text("x")
+    assert (target.stat().st_mode & 0o777) == (plain.stat().st_mode & 0o777)
