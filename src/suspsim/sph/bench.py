@@ -114,12 +114,14 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     calls = {"density": lambda: (
         summation_density(sim._x, box, sim._offset(sim.time), nl.start, nl.image_start,
                           nl.neighbours, sim._kernel, SUPPORT, sim._rho, tb.pair_end, tb.pair_j,
-                          tb.pair_geometry, sim._scratch_1, sim._bounds),
+                          tb.pair_geometry, tb.pair_cross, tb.pair_image, sim._scratch_1,
+                          sim._bounds),
         mass_density(sim._rho, sim._mass, sim._volume))}
     if sim._velocity_gradient:
         calls["gradient sums"] = lambda: _gradient_sums(
-            nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._v, sim._volume, shear_ly,
-            sim.scene.dimension, sim._grad_acc, sim._scratch_15, sim._bounds)
+            nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
+            sim._v, sim._volume, shear_ly, sim.scene.dimension, sim._grad_acc, sim._scratch_15,
+            sim._bounds)
         calls["gradient finish"] = lambda: _gradient_finish(
             sim._grad_acc, sim.scene.dimension, law.code, law.packed, sim._newtonian,
             sim._normalise, sim._beta, sim._gradient, sim._inverse_moment, sim._moment_trace,
@@ -133,8 +135,9 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
             sim._diss_acc, sim._dissipation, sim._gradient, sim._moment_trace, sim._mu,
             sim._alpha, sim._beta, sim.scene.dimension, sim._factor, sim._mu_hat)
     calls["force sums"] = lambda: force_sums(
-        nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._v, sim._rho, sim._volume,
-        sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2, sim._alpha, sim._beta,
+        nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
+        sim._v, sim._rho, sim._volume, sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2,
+        sim._alpha, sim._beta,
         sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of, sim._pressure,
         sim._force_acc,
         sim._scratch_6, sim._bounds, sim._virial)

@@ -4,13 +4,17 @@ d_p = Σ_q W(r_pq), self term included; ρ_p = m d_p (SPEC §2.2).
 
 The pass also writes the **pair table** of the step, which later passes (shear rate, forces)
 read instead of recomputing geometry: for each listed pair with r < h, in particle i's
-segment ``[start[i], pair_end[i])`` of the list's slots, ``pair_j[k]`` = j and the row
-``pair_geometry[k] = (dx, dy, dz, F, n)``: r_ij = r_i − r_j at its nearest image,
-F(r_ij) of the pass's kernel and the LE image index n (velocity correction
-v_ij,x −= n γ̇ L_y). r² = dx² + dy² + dz². Measured on the 32,768-particle benchmark box
-(one thread): writing it costs 1.0 ms here (1.9 → 2.9 ms) and saves 3.1 ms in a shear-rate
-pass (6.0 → 2.9 ms: no minimum image, no square root, no kernel, no skin pairs, which are
-32 % of the listed pairs at skin 0.2 h); an (N, 5) row per pair was faster than five arrays.
+segment ``[start[i], pair_end[i])`` of the list's slots, first the pairs inside the box, from
+``pair_cross[i]`` on those across a face; ``pair_j[k]`` = j, the row ``pair_geometry[k] =
+(dx, dy, dz, F)``: r_ij = r_i − r_j at its nearest image and F(r_ij) of the pass's kernel,
+and for a pair across a face ``pair_image[k]`` = n, its LE image index (velocity correction
+v_ij,x −= n γ̇ L_y; n = 0 inside the box). r² = dx² + dy² + dz². Measured on the
+32,768-particle benchmark box (one thread): writing it costs 1.0 ms here (1.9 → 2.9 ms) and
+saves 3.1 ms in a shear-rate pass (6.0 → 2.9 ms: no minimum image, no square root, no kernel,
+no skin pairs, which are 32 % of the listed pairs at skin 0.2 h); a row per pair was faster
+than an array per column, and n out of the row (int8: |n| ≤ 1 between rebuilds; read for the
+pairs across a face only) saves 0.28 ms per step (``integrator.accelerations`` 9.76 → 9.48
+ms: 32 instead of 40 bytes per pair read by three passes).
 
 Pattern of a pair pass:
 
@@ -20,6 +24,14 @@ Pattern of a pair pass:
   neighbours[image_start[i]:start[i+1]] cross a face and take ``minimum_image_3d``
   (6 % of the pairs; skipping three roundings for the rest: 13.3 → 6.2 ns per pair);
 - kernels evaluated branch-free for every listed pair (zero beyond h);
+- indices without numba's negative-index fix-up: k runs from 0 over per-particle views of the
+  list and the table, j is unsigned (``pair_j`` is uint32; this pass casts the list's int32)
+  and arrays with a row per particle are indexed ``a[j, c]``; a signed index costs a sign
+  test and keeps the array's length live, per access (before: density 2.05 ms, gradient sums
+  2.60, dissipation sums 1.47, force sums 2.61; after: 1.59, 2.36, 1.25, 2.24);
+- no array view that lives across a branch of a pair loop (index the 2D array instead):
+  numba then keeps its reference count, an atomic call per view and pair (force sums with a
+  row view ``acc[j]`` used on both sides of the ∇a branch: 3.46 ms);
 - kernel choice at build time at no cost in the loop: the pair loop is ``inline="always"``
   and called once per kernel code with that code as a constant, so one specialised loop is
   compiled per kernel (a runtime code inside the loop: 6.3 vs 4.5 ns per pair; function
@@ -59,7 +71,7 @@ from suspsim.sph.kernels import LUCY_2D, LUCY_3D, QUINTIC_2D, QUINTIC_3D, kernel
 from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
 
 #: Columns of ``pair_geometry``.
-DX, DY, DZ, F, N_IMAGE = range(5)
+DX, DY, DZ, F = range(4)
 
 
 @dataclass
@@ -69,39 +81,42 @@ class PairTable:
     pair_end: np.ndarray
     pair_j: np.ndarray
     pair_geometry: np.ndarray
+    pair_cross: np.ndarray
+    pair_image: np.ndarray
 
 
 def allocate_pair_table(n_particles: int, capacity: int) -> PairTable:
     """Pair table for a neighbour list of ``capacity`` slots."""
     return PairTable(pair_end=np.zeros(n_particles, dtype=np.int64),
-                     pair_j=np.zeros(capacity, dtype=np.int32),
-                     pair_geometry=np.zeros((capacity, 5)))
+                     pair_j=np.zeros(capacity, dtype=np.uint32),
+                     pair_geometry=np.zeros((capacity, 4)),
+                     pair_cross=np.zeros(n_particles, dtype=np.int64),
+                     pair_image=np.zeros(capacity, dtype=np.int8))
 
 
 _KERNEL_ERROR = "pair passes take the 2D and 3D kernel codes only"
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _pair(j, s, dx, dy, dz, n, kernel, h, h2, acc, pair_j, pair_geometry):
+def _pair(j, s, dx, dy, dz, kernel, h, h2, acc, pair_j, pair_geometry):
     """One listed pair (i, j) with r_ij = (dx, dy, dz): acc[j] += W(r) [SPEC §2.2]; writes
-    table slot s (kept, i.e. the next slot is s + 1, only if r < h); returns (W, next slot)."""
+    slot s of i's table segment (kept, i.e. the next slot is s + 1, only if r < h); returns
+    (W, next slot)."""
     r2 = dx * dx + dy * dy + dz * dz
     r = math.sqrt(r2)
     w = kernel_w(kernel, r, h)
     acc[j] += w
     pair_j[s] = j
-    row = pair_geometry[s]
-    row[DX] = dx
-    row[DY] = dy
-    row[DZ] = dz
-    row[F] = kernel_f(kernel, r, h)
-    row[N_IMAGE] = n
+    pair_geometry[s, DX] = dx
+    pair_geometry[s, DY] = dy
+    pair_geometry[s, DZ] = dz
+    pair_geometry[s, F] = kernel_f(kernel, r, h)
     return w, s + (r2 < h2)
 
 
 @njit(inline="always", **JIT_OPTIONS)
 def _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours, kernel, h,
-                  acc, pair_end, pair_j, pair_geometry):
+                  acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image):
     """acc[p] += Σ_q W(r_pq) over the listed pairs of particles lo..hi−1 (both ends), + W(0);
     pair table of lo..hi−1."""
     lx, ly, lz = box[0], box[1], box[2]
@@ -110,38 +125,45 @@ def _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours
     for i in range(lo, hi):
         xi, yi, zi = positions[i, 0], positions[i, 1], positions[i, 2]
         own = w0
-        s = start[i]
-        for k in range(start[i], image_start[i]):
-            j = neighbours[k]
+        first, last = start[i], start[i + 1]
+        listed = neighbours[first:last]
+        js, rows, images = pair_j[first:last], pair_geometry[first:last], pair_image[first:last]
+        n_plain = image_start[i] - first
+        s = 0
+        for k in range(n_plain):
+            j = np.uint32(listed[k])
             w, s = _pair(j, s, xi - positions[j, 0], yi - positions[j, 1], zi - positions[j, 2],
-                         0.0, kernel, h, h2, acc, pair_j, pair_geometry)
+                         kernel, h, h2, acc, js, rows)
             own += w
-        for k in range(image_start[i], start[i + 1]):
-            j = neighbours[k]
+        pair_cross[i] = first + s
+        crossing = listed[n_plain:]
+        for k in range(crossing.shape[0]):
+            j = np.uint32(crossing[k])
             dx, dy, dz, n = minimum_image_3d(xi - positions[j, 0], yi - positions[j, 1],
                                              zi - positions[j, 2], lx, ly, lz, offset)
-            w, s = _pair(j, s, dx, dy, dz, n, kernel, h, h2, acc, pair_j, pair_geometry)
+            images[s] = n
+            w, s = _pair(j, s, dx, dy, dz, kernel, h, h2, acc, js, rows)
             own += w
-        pair_end[i] = s
+        pair_end[i] = first + s
         acc[i] += own
 
 
 @njit(**JIT_OPTIONS)
 def _density_chunk(lo, hi, positions, box, offset, start, image_start, neighbours, kernel, h,
-                   acc, pair_end, pair_j, pair_geometry):
+                   acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image):
     """:func:`_density_loop` compiled once per kernel code (the code is a constant in each)."""
     if kernel == LUCY_3D:
         _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours, LUCY_3D,
-                      h, acc, pair_end, pair_j, pair_geometry)
+                      h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
     elif kernel == LUCY_2D:
         _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours, LUCY_2D,
-                      h, acc, pair_end, pair_j, pair_geometry)
+                      h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
     elif kernel == QUINTIC_3D:
         _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
-                      QUINTIC_3D, h, acc, pair_end, pair_j, pair_geometry)
+                      QUINTIC_3D, h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
     elif kernel == QUINTIC_2D:
         _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
-                      QUINTIC_2D, h, acc, pair_end, pair_j, pair_geometry)
+                      QUINTIC_2D, h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
     else:
         raise ValueError(_KERNEL_ERROR)
 
@@ -156,17 +178,19 @@ def mass_density(density, mass, volume):
 
 @njit(**JIT_OPTIONS)
 def summation_density_serial(positions, box, offset, start, image_start, neighbours, kernel, h,
-                             density, pair_end, pair_j, pair_geometry):
+                             density, pair_end, pair_j, pair_geometry, pair_cross, pair_image):
     """d_p = Σ_q W(r_pq) incl. self [SPEC §2.2; Martys 2010 Eq. 6] and the pair table, one
     thread; arguments as :func:`summation_density`."""
     density[:] = 0.0
     _density_chunk(0, positions.shape[0], positions, box, offset, start, image_start,
-                   neighbours, kernel, h, density, pair_end, pair_j, pair_geometry)
+                   neighbours, kernel, h, density, pair_end, pair_j, pair_geometry, pair_cross,
+                   pair_image)
 
 
 @njit(parallel=True, **JIT_OPTIONS)
 def summation_density(positions, box, offset, start, image_start, neighbours, kernel, h,
-                      density, pair_end, pair_j, pair_geometry, scratch, bounds):
+                      density, pair_end, pair_j, pair_geometry, pair_cross, pair_image, scratch,
+                      bounds):
     """d_p = Σ_q W(r_pq) incl. self [SPEC §2.2; Martys 2010 Eq. 6] and the pair table, parallel.
 
     Parameters
@@ -177,7 +201,8 @@ def summation_density(positions, box, offset, start, image_start, neighbours, ke
     start, image_start, neighbours : CSR half list from ``build_neighbour_list``
     kernel : int, kernel code (``kernels.LUCY_3D`` ...); h : support radius
     density : (N,) float64, output
-    pair_end, pair_j, pair_geometry : output pair table (:func:`allocate_pair_table`)
+    pair_end, pair_j, pair_geometry, pair_cross, pair_image : output pair table
+        (:func:`allocate_pair_table`)
     scratch : (T − 1, N) float64: the pass runs T chunks (one row per chunk after the
         first); T = ``numba.get_num_threads()`` for full speed, T = 1 (shape (0, N)) serial
     bounds : (T + 1,) int64 scratch for the chunk bounds
@@ -191,12 +216,13 @@ def summation_density(positions, box, offset, start, image_start, neighbours, ke
         if c == 0:
             density[:] = 0.0
             _density_chunk(lo, hi, positions, box, offset, start, image_start, neighbours,
-                           kernel, h, density, pair_end, pair_j, pair_geometry)
+                           kernel, h, density, pair_end, pair_j, pair_geometry, pair_cross,
+                           pair_image)
         else:
             acc = scratch[c - 1]
             acc[lo:] = 0.0
             _density_chunk(lo, hi, positions, box, offset, start, image_start, neighbours,
-                           kernel, h, acc, pair_end, pair_j, pair_geometry)
+                           kernel, h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
     add_chunk_buffers(density, scratch, bounds, n_chunks, 1)
 
 

@@ -65,8 +65,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, normalise, alpha, beta, bulk_factor,
                   bulk_gradient, has_bodies, body_of, rho, volume, pressure, pair_end, pair_j,
-                  geometry, gradient,
-                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
+                  geometry, pair_cross, pair_image, gradient, inverse_moment, moment_trace,
+                  strain, dissipation, gdot, viscosity, factor,
                   viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6,
                   bounds, virial, accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
@@ -80,14 +80,14 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     """
     shear_ly = shear_rate * box[1]
     summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
-                      rho, pair_end, pair_j, geometry, scratch_1, bounds)
+                      rho, pair_end, pair_j, geometry, pair_cross, pair_image, scratch_1, bounds)
     mass_density(rho, mass, volume)
     if has_bodies:
         body_particle_density(nl_start, pair_end, pair_j, geometry, body_of, kernel, h, rho,
                               rho_eq, c2, mass, dissipation, diss_acc, volume)
     if velocity_gradient:
-        _gradient_sums(nl_start, pair_end, pair_j, geometry, predicted, volume, shear_ly,
-                       dimension, grad_acc, scratch_15, bounds)
+        _gradient_sums(nl_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted,
+                       volume, shear_ly, dimension, grad_acc, scratch_15, bounds)
         _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian, normalise, beta,
                          gradient, inverse_moment, moment_trace, gdot, viscosity, strain,
                          dissipation)
@@ -99,9 +99,9 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                               beta, dimension, factor, viscosity_hat)
     elif not newtonian:
         viscosity_hat[:] = viscosity
-    force_sums(nl_start, pair_end, pair_j, geometry, predicted, rho, volume, viscosity_hat, mass,
-               rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of, pressure,
-               force_acc, scratch_6, bounds, virial)
+    force_sums(nl_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
+               volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
+               shear_ly, body_of, pressure, force_acc, scratch_6, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
 
@@ -112,9 +112,9 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
-                  volume, pressure, pair_end, pair_j, geometry, gradient, inverse_moment,
-                  moment_trace, strain,
-                  dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
+                  volume, pressure, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
+                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
+                  viscosity_hat, grad_acc, diss_acc,
                   force_acc, scratch_1, scratch_15, scratch_6, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, rebuild?).
 
@@ -136,8 +136,9 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                       nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate, body_force,
                       dimension, law_code, law_params, newtonian, velocity_gradient, normalise,
                       alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
-                      volume, pressure, pair_end, pair_j, geometry, gradient, inverse_moment, moment_trace, strain,
-                      dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc,
+                      volume, pressure, pair_end, pair_j, geometry, pair_cross, pair_image,
+                      gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
+                      factor, viscosity_hat, grad_acc, diss_acc,
                       force_acc, scratch_1, scratch_15, scratch_6, bounds, virial, accel_new)
         kick(velocities, accel, accel_new, dt)
         done += 1

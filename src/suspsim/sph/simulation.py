@@ -188,7 +188,7 @@ class Simulation:
         self._body_of = np.full(n, -1, dtype=np.int64)
         self._offsets = np.zeros((n, 3))
         self._members = np.zeros(0, dtype=np.int64)
-        self._grad_c = np.zeros((n, 3)) if self._shifting > 0.0 else np.zeros((0, 3))
+        self._grad_c = np.zeros(3 * n if self._shifting > 0.0 else 0)
         self._body_virial = np.zeros(5)
         self._lubrication_virial = np.zeros(5)
         self._lubrication_stats = np.array([np.inf, 0.0, 0.0])
@@ -245,7 +245,8 @@ class Simulation:
                 self._velocity_gradient, self._normalise, self._alpha, self._beta,
                 self._bulk_factor, self._bulk_gradient, self.bodies is not None, self._body_of,
                 self._rho, self._volume,
-                self._pressure, tb.pair_end, tb.pair_j, tb.pair_geometry, self._gradient,
+                self._pressure, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross,
+                tb.pair_image, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
                 self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
                 self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,
@@ -372,7 +373,8 @@ class Simulation:
                 tb = self._table
                 shift_particles(self._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
                                 self._volume, self._body_of, self._shifting, self._rate, dt,
-                                SUPPORT, self._gradient, self._grad_c, self._x, self._v)
+                                SUPPORT, self._gradient, self._grad_c, self._scratch_15,
+                                self._bounds, self._x, self._v)
             if self._mean_reference:
                 self._rho_eq = self._fluid_mean_density()
             self.step_count += 1

@@ -8,7 +8,7 @@ import pytest
 
 from suspsim.sph import kernels as K
 from suspsim.sph import neighbours as nb
-from suspsim.sph.density import (DX, DZ, F, N_IMAGE, allocate_pair_table, summation_density,
+from suspsim.sph.density import (DX, DZ, F, allocate_pair_table, summation_density,
                                  summation_density_serial)
 
 CUTOFF = 1.0
@@ -239,7 +239,7 @@ def density_pass(positions, box, offset, nlist, kernel, h, n_chunks=2, table=Non
     bounds = np.empty(n_chunks + 1, dtype=np.int64)
     summation_density(positions, box, offset, nlist.start, nlist.image_start, nlist.neighbours,
                       kernel, h, density, table.pair_end, table.pair_j, table.pair_geometry,
-                      scratch, bounds)
+                      table.pair_cross, table.pair_image, scratch, bounds)
     return density
 
 
@@ -258,7 +258,7 @@ def test_density_equals_brute_force(dim, kernel, offset):
     table = allocate_pair_table(len(moved), len(nlist.neighbours))
     summation_density_serial(moved, box, offset, nlist.start, nlist.image_start,
                              nlist.neighbours, kernel, h, serial, table.pair_end, table.pair_j,
-                             table.pair_geometry)
+                             table.pair_geometry, table.pair_cross, table.pair_image)
     np.testing.assert_allclose(serial, expected, rtol=1e-12)
     np.testing.assert_array_equal(density_pass(moved, box, offset, nlist, kernel, h, 1), serial)
     for chunks in (2, 3):
@@ -267,7 +267,9 @@ def test_density_equals_brute_force(dim, kernel, offset):
             density_pass(moved, box, offset, nlist, kernel, h, chunks, parallel_table),
             serial, rtol=1e-14)
         np.testing.assert_array_equal(parallel_table.pair_end, table.pair_end)
-    # pair table: exactly the pairs within h, with nearest-image vector, F and image index
+        np.testing.assert_array_equal(parallel_table.pair_cross, table.pair_cross)
+    # pair table: exactly the pairs within h, with nearest-image vector, F and image index (in
+    # pair_image from pair_cross on, the pairs across a face; the others are inside the box)
     counts = table.pair_end - nlist.start[:-1]
     i = np.repeat(np.arange(len(moved)), counts)
     k = np.concatenate([np.arange(a, b) for a, b in zip(nlist.start[:-1], table.pair_end)])
@@ -275,13 +277,15 @@ def test_density_equals_brute_force(dim, kernel, offset):
     assert set(zip(i.tolist(), j.tolist())) == {
         (min(a, b), max(a, b)) for a, b in zip(*np.nonzero(np.triu(r < h, 1)))}
     rows = table.pair_geometry[k]
-    for a, b, row in zip(i, j, rows):
+    crossing = k >= np.repeat(table.pair_cross, counts)
+    for a, b, row, across, image in zip(i, j, rows, crossing, table.pair_image[k]):
         d = moved[a] - moved[b]
         n = np.rint(d[1] / box[1])
         shift = [n * offset + box[0] * np.rint((d[0] - n * offset) / box[0]), n * box[1],
                  box[2] * np.rint(d[2] / box[2]) if dim == 3 else 0.0]
         np.testing.assert_allclose(row[DX:DZ + 1], d - shift, atol=1e-12)
-        assert row[N_IMAGE] == n
+        assert (image if across else 0) == n
+        assert across or not np.any(shift)
         assert row[F] == pytest.approx(K.kernel_f(kernel, np.linalg.norm(d - shift), h))
 
 

@@ -41,9 +41,11 @@ VXX, VYY, VZZ, VXY, VYX = range(5)
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure, viscosity,
-                alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of, acc, virial_row):
+def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity,
+                volume, pressure, viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
+                body_of, acc, virial_row):
     """acc[6 i ...] += forces (and ∇a sums) of particles lo..hi−1, both ends; virial_row +=."""
+    sums = acc.reshape((acc.shape[0] // FORCE_WIDTH, FORCE_WIDTH))
     sxx = syy = szz = sxy = syx = 0.0
     for i in range(lo, hi):
         p_i = pressure[i]
@@ -54,14 +56,18 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pre
         vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
         fxi = fyi = fzi = 0.0
         gxi = gyi = gzi = 0.0
-        for k in range(start[i], pair_end[i]):
-            j = pair_j[k]
+        first, last = start[i], pair_end[i]
+        js, rows, images = pair_j[first:last], geometry[first:last], pair_image[first:last]
+        n_plain = pair_cross[i] - first
+        for k in range(js.shape[0]):
+            j = js[k]
             if body_i >= 0 and body_of[j] == body_i:
                 continue
-            row = geometry[k]
-            dx, dy, dz, f = row[0], row[1], row[2], row[3]
+            dx, dy, dz, f = rows[k, 0], rows[k, 1], rows[k, 2], rows[k, 3]
             r2 = dx * dx + dy * dy + dz * dz
-            vx = vxi - velocity[j, 0] - row[4] * shear_ly
+            vx = vxi - velocity[j, 0]
+            if k >= n_plain:
+                vx -= images[k] * shear_ly
             vy = vyi - velocity[j, 1]
             vz = vzi - velocity[j, 2]
             vol_j = volume[j]
@@ -74,10 +80,9 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pre
             fxi += fx
             fyi += fy
             fzi += fz
-            b = FORCE_WIDTH * j
-            acc[b] -= fx
-            acc[b + 1] -= fy
-            acc[b + 2] -= fz
+            sums[j, 0] -= fx
+            sums[j, 1] -= fy
+            sums[j, 2] -= fz
             sxx += fx * dx
             syy += fy * dy
             szz += fz * dz
@@ -90,16 +95,15 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pre
                 gyi += tj * dy
                 gzi += tj * dz
                 ti = t * vol_i
-                acc[b + 3] += ti * dx
-                acc[b + 4] += ti * dy
-                acc[b + 5] += ti * dz
-        b = FORCE_WIDTH * i
-        acc[b] += fxi
-        acc[b + 1] += fyi
-        acc[b + 2] += fzi
-        acc[b + 3] += gxi
-        acc[b + 4] += gyi
-        acc[b + 5] += gzi
+                sums[j, 3] += ti * dx
+                sums[j, 4] += ti * dy
+                sums[j, 5] += ti * dz
+        sums[i, 0] += fxi
+        sums[i, 1] += fyi
+        sums[i, 2] += fzi
+        sums[i, 3] += gxi
+        sums[i, 4] += gyi
+        sums[i, 5] += gzi
     virial_row[VXX] = sxx
     virial_row[VYY] = syy
     virial_row[VZZ] = szz
@@ -108,9 +112,9 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pre
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def force_sums(start, pair_end, pair_j, geometry, velocity, rho, volume, viscosity, mass, rho_eq,
-               c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of, pressure, acc,
-               scratch, bounds, virial):
+def force_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity, rho, volume,
+               viscosity, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
+               body_of, pressure, acc, scratch, bounds, virial):
     """acc (6 N,) = pair forces and ∇a sums of every particle; virial (T, 5) per chunk;
     ``pressure`` (N,) scratch for the particles' m² P/ρ²; ``body_of`` (N,) the rigid body of
     each particle, −1 for fluid."""
@@ -122,15 +126,15 @@ def force_sums(start, pair_end, pair_j, geometry, velocity, rho, volume, viscosi
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:
             acc[:] = 0.0
-            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure,
-                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of,
-                        acc, virial[0])
+            _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image,
+                        velocity, volume, pressure, viscosity, alpha, beta, bulk_factor,
+                        bulk_gradient, shear_ly, body_of, acc, virial[0])
         else:
             buffer = scratch[c - 1]
             buffer[FORCE_WIDTH * lo:] = 0.0
-            _force_loop(lo, hi, start, pair_end, pair_j, geometry, velocity, volume, pressure,
-                        viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly, body_of,
-                        buffer, virial[c])
+            _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image,
+                        velocity, volume, pressure, viscosity, alpha, beta, bulk_factor,
+                        bulk_gradient, shear_ly, body_of, buffer, virial[c])
     add_chunk_buffers(acc, scratch, bounds, n_chunks, FORCE_WIDTH)
 
 

@@ -25,53 +25,83 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
+from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
 
 #: Largest shift per step [h] (SPEC §5.5: 0.1 h).
 MAX_SHIFT = 0.1
 
 
-@njit(**JIT_OPTIONS)
-def shift_particles(start, pair_end, pair_j, geometry, volume, body_of, coefficient, shear_rate,
-                    dt, h, gradient, grad_c, positions, velocities):
-    """Shift every fluid particle (module docstring); ``grad_c`` (N, 3) scratch ← ∇C;
-    ``gradient`` (N, 9) the step's ∂_k v_l (``terms.gradient``). Returns the largest shift [h]."""
-    n = positions.shape[0]
-    for i in range(n):
-        grad_c[i, 0] = 0.0
-        grad_c[i, 1] = 0.0
-        grad_c[i, 2] = 0.0
-    for i in range(n):
+@njit(inline="always", **JIT_OPTIONS)
+def _concentration_loop(lo, hi, start, pair_end, pair_j, geometry, volume, acc):
+    """acc[3i + a] += (∇C_i)_a = −Σ_j V_j F r_ij,a for particles lo..hi−1, both ends of each
+    pair (``acc`` flat (3N,))."""
+    for i in range(lo, hi):
         vol_i = volume[i]
-        for k in range(start[i], pair_end[i]):
-            j = pair_j[k]
-            row = geometry[k]
-            f = row[3]
-            for a in range(3):
-                grad_c[i, a] -= volume[j] * f * row[a]
-                grad_c[j, a] += vol_i * f * row[a]
+        gx = gy = gz = 0.0
+        js, rows = pair_j[start[i]:pair_end[i]], geometry[start[i]:pair_end[i]]
+        for k in range(js.shape[0]):
+            j = js[k]
+            row = rows[k]
+            fj = volume[j] * row[3]
+            fi = vol_i * row[3]
+            gx -= fj * row[0]
+            gy -= fj * row[1]
+            gz -= fj * row[2]
+            b = 3 * j
+            acc[b] += fi * row[0]
+            acc[b + 1] += fi * row[1]
+            acc[b + 2] += fi * row[2]
+        b = 3 * i
+        acc[b] += gx
+        acc[b + 1] += gy
+        acc[b + 2] += gz
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def concentration_gradient(start, pair_end, pair_j, geometry, volume, acc, scratch, bounds):
+    """acc (3N,) = ∇C of every particle over the half pair table, in T = scratch.shape[0] + 1
+    chunks (the pattern of ``density``; ``scratch`` rows of at least 3N entries)."""
+    n_chunks = scratch.shape[0] + 1
+    chunk_bounds(start, n_chunks, bounds)
+    n3 = acc.shape[0]
+    for c in prange(n_chunks):
+        lo, hi = bounds[c], bounds[c + 1]
+        if c == 0:
+            acc[:] = 0.0
+            _concentration_loop(lo, hi, start, pair_end, pair_j, geometry, volume, acc)
+        else:
+            buffer = scratch[c - 1, :n3]
+            buffer[3 * lo:] = 0.0
+            _concentration_loop(lo, hi, start, pair_end, pair_j, geometry, volume, buffer)
+    add_chunk_buffers(acc, scratch, bounds, n_chunks, 3)
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def shift_particles(start, pair_end, pair_j, geometry, volume, body_of, coefficient, shear_rate,
+                    dt, h, gradient, grad_c, scratch, bounds, positions, velocities):
+    """Shift every fluid particle (module docstring); ``grad_c`` (3N,) scratch ← ∇C,
+    ``scratch`` and ``bounds`` those of the chunked pair passes; ``gradient`` (N, 9) the
+    step's ∂_k v_l (``terms.gradient``)."""
+    concentration_gradient(start, pair_end, pair_j, geometry, volume, grad_c, scratch, bounds)
     diffusion = coefficient * h * h * abs(shear_rate) * dt
-    largest = 0.0
-    for i in range(n):
+    for i in prange(positions.shape[0]):
         if body_of[i] >= 0:
             continue
-        dx = -diffusion * grad_c[i, 0]
-        dy = -diffusion * grad_c[i, 1]
-        dz = -diffusion * grad_c[i, 2]
+        dx = -diffusion * grad_c[3 * i]
+        dy = -diffusion * grad_c[3 * i + 1]
+        dz = -diffusion * grad_c[3 * i + 2]
         size = math.sqrt(dx * dx + dy * dy + dz * dz)
         if size > MAX_SHIFT * h:
             scale = MAX_SHIFT * h / size
             dx *= scale
             dy *= scale
             dz *= scale
-            size = MAX_SHIFT * h
-        largest = max(largest, size)
         g = gradient[i]
         for l in range(3):
             velocities[i, l] += dx * g[l] + dy * g[3 + l] + dz * g[6 + l]
         positions[i, 0] += dx
         positions[i, 1] += dy
         positions[i, 2] += dz
-    return largest
