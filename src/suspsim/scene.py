@@ -147,8 +147,33 @@ class InclusionsSpec:
         return self.phi > 0.0 or self.packing is not None
 
 
+class RunTimes:
+    """Run length, sampling interval and transient as simulated time, for a scene whose
+    ``run`` gives ``time`` or ``strain`` (its ``length``, ``output_interval``, ``transient``
+    in that unit) and whose ``strain_rate`` turns strain into time."""
+
+    @property
+    def total_time(self) -> float:
+        """Simulated time of the whole run [time unit of the scene]."""
+        return self.to_time(self.run.length)
+
+    @property
+    def output_interval_time(self) -> float:
+        """Time between samples."""
+        return self.to_time(self.run.output_interval)
+
+    @property
+    def transient_time(self) -> float:
+        """Time discarded before averaging."""
+        return self.to_time(self.run.transient)
+
+    def to_time(self, value: float) -> float:
+        """Convert a value in the run-length unit (strain or time) to time."""
+        return value if self.run.time is not None else value / self.strain_rate
+
+
 @dataclass(frozen=True)
-class Scene:
+class Scene(RunTimes):
     """A complete, validated scene; ``box`` [h] is (x flow, y gradient[, z]), ``number_density`` [h^-d]."""
 
     dimension: int
@@ -190,23 +215,9 @@ class Scene:
         return lattice_counts(self.box, self.number_density)
 
     @property
-    def total_time(self) -> float:
-        """Simulated time of the whole run [τ]."""
-        return self.to_time(self.run.length)
-
-    @property
-    def output_interval_time(self) -> float:
-        """Time between samples [τ]."""
-        return self.to_time(self.run.output_interval)
-
-    @property
-    def transient_time(self) -> float:
-        """Time discarded before averaging [τ]."""
-        return self.to_time(self.run.transient)
-
-    def to_time(self, value: float) -> float:
-        """Convert a value in the run-length unit (strain or τ) to time [τ]."""
-        return value if self.run.time is not None else value / self.flow.shear_rate
+    def strain_rate(self) -> float:
+        """The rate that turns strain into time [τ⁻¹] (couette's shear rate)."""
+        return self.flow.shear_rate
 
     def to_dict(self) -> dict:
         """The complete scene, defaults included, as plain JSON-able data."""

@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import InputError
 from ..io.schema import fail_at, fill_defaults, load_schema, validate
 from ..io.yamlfile import load_yaml
+from ..scene import RunTimes
 from .parameters import Channel, Geometry, Numerics, StressCouette, WyartCatesFluid
 
 #: The DST scene schema (a dict), with a description and default for every optional key.
@@ -85,7 +86,7 @@ class DSTRunSpec:
 
 
 @dataclass(frozen=True)
-class DSTScene:
+class DSTScene(RunTimes):
     """A complete, validated DST scene (see the module docstring); ``box`` = (L_x, L_y)."""
 
     box: tuple[float, float]
@@ -113,21 +114,10 @@ class DSTScene:
         return self.fluid.shear_rate(self.flow.stress) if self.flow_type == "stress_couette" \
             else None
 
-    def to_time(self, value: float) -> float:
-        """A value in the run-length unit (strain or T) as time [T]."""
-        return value if self.run.time is not None else value / self.nominal_shear_rate
-
     @property
-    def total_time(self) -> float:
-        return self.to_time(self.run.length)
-
-    @property
-    def output_interval_time(self) -> float:
-        return self.to_time(self.run.output_interval)
-
-    @property
-    def transient_time(self) -> float:
-        return self.to_time(self.run.transient)
+    def strain_rate(self) -> float | None:
+        """The rate that turns strain into time [T⁻¹]: :attr:`nominal_shear_rate`."""
+        return self.nominal_shear_rate
 
     def build(self, *, threads: int | None = None):
         """A fresh :class:`~suspsim.dst.simulation.DSTSimulation` of this scene."""
