@@ -1,21 +1,26 @@
-"""Make docs/figures/squeeze_force.png: resolved SPH squeeze force between two spheres.
+"""Make docs/figures/squeeze_force.{nc,png}: resolved SPH squeeze force between two spheres.
 
     python docs/figures/make_squeeze.py [--threads N] [--reduced] [--no-large]
+    python docs/figures/make_squeeze.py --plot-only    # redraw from the .nc
 
 Runs :func:`suspsim.validation.squeeze.squeeze_study` for a = 2.5 h (box 25 × 20 × 20 h,
 Re = 0.05, and the same at half the speed for the quasi-steady check) and a = 4 h (box
 32 × 25 × 25 h, Re = 0.1; skipped with --no-large), draws them with
 :func:`suspsim.plotting.squeeze.plot_squeeze` and prints the table s, F/F_theory and the
-recommended cutoff gap. --reduced: the test's small case only.
+recommended cutoff gap. --reduced: the test's small case only. The runs are kept in
+``squeeze_force.nc`` (netCDF4 groups, one per run, named by its label).
 """
 import argparse
 from pathlib import Path
 
-from suspsim.io.atomic import save_figure
+import xarray as xr
+
+from suspsim.io.atomic import atomic_path, save_figure
 from suspsim.plotting.squeeze import plot_squeeze
 from suspsim.validation.squeeze import squeeze_study, stokes_drag
 
 OUTPUT = Path(__file__).resolve().with_name("squeeze_force.png")
+NETCDF = OUTPUT.with_suffix(".nc")
 
 
 def _table(data, title):
@@ -31,14 +36,34 @@ def _table(data, title):
         print(f"  {s:6.3f}   {n:12.4g}   {r:11.3f}   {rn:9.3f}   {c:8.3f}")
 
 
+def _save(runs, labels) -> None:
+    """All runs into :data:`NETCDF`, one group per run (``box`` as a variable: netCDF
+    attributes hold no arrays of that kind), written atomically."""
+    groups = {}
+    for k, (data, label) in enumerate(zip(runs, labels)):
+        data = data.copy()
+        data.attrs = {key: (list(map(float, value)) if key == "box" else value)
+                      for key, value in data.attrs.items()}
+        data.attrs["label"] = label
+        groups[f"run{k}"] = data
+    with atomic_path(NETCDF) as tmp:
+        xr.DataTree.from_dict(groups).to_netcdf(tmp, engine="netcdf4")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--threads", type=int, default=1, help="solver threads (default 1)")
     parser.add_argument("--reduced", action="store_true", help="the test's reduced case")
     parser.add_argument("--no-large", action="store_true", help="skip a = 4 h")
+    parser.add_argument("--plot-only", action="store_true", help=f"redraw from {NETCDF.name}")
     args = parser.parse_args()
     runs, labels = [], []
-    if args.reduced:
+    if args.plot_only:
+        with xr.open_datatree(NETCDF) as tree:
+            for node in tree.children.values():
+                runs.append(node.to_dataset().load())
+                labels.append(node.attrs["label"])
+    elif args.reduced:
         runs.append(squeeze_study(2.5, (20.0, 15.0, 15.0), reynolds=0.1, end_gap=0.2,
                                   threads=args.threads))
         labels.append("a = 2.5 h, reduced")
@@ -55,6 +80,8 @@ def main() -> None:
             labels.append("a = 4 h, Re = 0.1")
     for data, label in zip(runs, labels):
         _table(data, label)
+    if not args.plot_only:
+        _save(runs, labels)
     save_figure(plot_squeeze(runs, labels=labels), OUTPUT)
     print(f"\nwrote {OUTPUT}")
 

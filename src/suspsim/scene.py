@@ -108,6 +108,7 @@ class NumericsSpec:
     viscous_normalisation: bool
     wi_target: float
     shifting: float
+    shifting_rate: float
     pressure_reference: str
     dt_viscous_coefficient: float
 

@@ -11,6 +11,7 @@ spread, and the ``fluid_mean`` pressure reference keeps the mean pressure at zer
 disordered configuration a uniform pressure exerts forces and an anisotropic stress. Scenes
 with inclusions get both by default (A = 30, the schema documents the measurements).
 """
+import functools
 import os
 import sys
 from pathlib import Path
@@ -55,11 +56,11 @@ def test_einstein_limit_of_one_sphere():
     η_r = σ_xy/(γ̇ μ) against the matrix law as ``suspsim run`` reports it, and the same fluid
     without the sphere within 1.5 % of μ.
 
-    Measured (strain 1–9): η_r = 1.0766, [η] = 2.55; the sphere's stresslet (the body
-    correction of SPEC §3.5) 0.073 μγ̇ and the fluid's share 1.000 μγ̇. The fluid alone
-    reads 0.991 (a sheared lattice), so against it [η] = 2.87. Before the fluid_mean reference
-    the fluid's share followed the mean pressure: [η] = 4.6 without shifting, 1.2 at A = 30 and
-    Wi = 10⁻². A periodic array's own O(φ^(5/3)) correction is not subtracted."""
+    Measured (strain 1–9): η_r = 1.0824, [η] = 2.75 (2.55 when fluid lattice sites within half
+    a spacing of the surface were removed, inclusions.fluid_margin 0.5, which left the fluid
+    16 % short of particles at φ = 0.3). Before the fluid_mean reference the fluid's share
+    followed the mean pressure: [η] = 4.6 without shifting, 1.2 at A = 30 and Wi = 10⁻². A
+    periodic array's own O(φ^(5/3)) correction is not subtracted."""
     units = 3 if REDUCED else 8
     fluid, _ = measured_viscosity_ratio(scene(12.5), units=units)
     suspension, sim = measured_viscosity_ratio(scene(12.5, phi=0.03), units=units)
@@ -67,3 +68,30 @@ def test_einstein_limit_of_one_sphere():
     assert fluid == pytest.approx(1.0, abs=0.015)
     intrinsic = (suspension - 1.0) / sim.packing_phi
     assert intrinsic == pytest.approx(2.5, abs=0.4)
+
+
+@functools.cache
+def _dense(phi):
+    """η_r of spheres a = 2.5 h at ``phi`` in a 15 h box with the defaults (seed 1); cached,
+    two tests read φ = 0.4."""
+    ratio, sim = measured_viscosity_ratio(scene(15.0, phi=phi), transient=1 if REDUCED else 2,
+                                          units=3 if REDUCED else 8)
+    assert sim.packing_phi == pytest.approx(phi)
+    return ratio
+
+
+def test_dense_suspension_runs_and_thickens_above_einstein():
+    """φ = 0.2 and 0.4 run healthy with the defaults, each η_r above Einstein's 1 + 2.5 φ and
+    rising with φ. Measured (seeds 1 and 2, strain 2–10): 1.85, 1.71 at 0.2; 4.33, 4.61 at 0.4."""
+    low, high = _dense(0.2), _dense(0.4)
+    assert 1.0 + 2.5 * 0.2 < low < high
+    assert high > 1.0 + 2.5 * 0.4
+
+
+@pytest.mark.xfail(strict=True, reason="measured η_r at a = 2.5 h (15 h box, seeds 1/2, strain "
+                   "2-10): 1.25/1.25 at φ = 0.1, 1.85/1.71 at 0.2, 2.53 at 0.3, 4.33/4.61 at 0.4, "
+                   "7.7 at 0.5, below the envelope (5.6-8.8 at 0.4); at φ = 0.3 a = 3.33 h "
+                   "reads 15-35 % higher than 2.5 h: the near field is under-resolved (issue 4)")
+def test_dense_suspension_inside_published_envelope():
+    """REFERENCE_NUMBERS §2a: the min–max of the experimental fits, 5.61–8.78 at φ = 0.4."""
+    assert 5.61 <= _dense(0.4) <= 8.78

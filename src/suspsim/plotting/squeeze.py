@@ -11,9 +11,9 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
     """Two panels against the nominal gap s [h] (log axis), one colour per dataset.
 
     ``datasets``: outputs of :func:`suspsim.validation.squeeze.squeeze_study` (a Dataset or a
-    sequence). Top: F/(6πμaU) measured (markers) and the theory with the hydrodynamic radius
-    a_h (line; dashed: nominal a). Bottom: F_SPH/F_theory(a_h) with the ``threshold`` line and
-    each run's cutoff gap s_c marked. ``labels``: legend entries (default: a, a_h/a, U).
+    sequence). Top: F/(6πμaU) measured (markers) and the theory with the nominal radius a, which
+    the Einstein coefficient calibrates (line; dashed: the drag's hydrodynamic radius a_h).
+    Bottom: F_SPH/F_theory(a) with the ``threshold`` line and each run's cutoff gap s_c marked. ``labels``: legend entries (default: a, a_h/a, U).
     """
     if isinstance(datasets, xr.Dataset):
         datasets = [datasets]
@@ -29,14 +29,14 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
         gap = data["gap"].values
         top.errorbar(gap, data["force"].values / scale, yerr=data["force_error"].values / scale,
                      fmt="o", ms=3, color=colour, label=f"SPH, {label}")
-        top.plot(gap, data["theory_force"].values / scale, "-", color=colour, lw=1.2)
-        top.plot(gap, data["theory_force_nominal"].values / scale, "--", color=colour, lw=0.8)
-        bottom.plot(gap, data["ratio"].values, "o-", ms=3, color=colour, label=label)
+        top.plot(gap, data["theory_force_nominal"].values / scale, "-", color=colour, lw=1.2)
+        top.plot(gap, data["theory_force"].values / scale, "--", color=colour, lw=0.8)
+        bottom.plot(gap, data["ratio_nominal"].values, "o-", ms=3, color=colour, label=label)
         cutoff = data.attrs.get("cutoff_gap", np.nan)
         if np.isfinite(cutoff):
             bottom.axvline(cutoff, color=colour, ls=":", lw=1)
-    top.plot([], [], "k-", lw=1.2, label="Jeffrey & Onishi, radius a_h, box images")
-    top.plot([], [], "k--", lw=0.8, label="the same, nominal radius a")
+    top.plot([], [], "k-", lw=1.2, label="Jeffrey & Onishi, nominal radius a, box images")
+    top.plot([], [], "k--", lw=0.8, label="the same, radius a_h of the drag")
     top.set_xscale("log")
     top.set_yscale("log")
     top.set_ylabel("squeeze force F/(6πμaU) [1]")
@@ -44,6 +44,6 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
     bottom.axhline(1.0, color="0.5", lw=0.8)
     bottom.axhline(threshold, color="0.3", ls="--", lw=0.8, label=f"{threshold:g} × theory")
     bottom.set_xlabel("surface gap s = r − 2a [h]")
-    bottom.set_ylabel("F_SPH / F_theory(a_h) [1]")
+    bottom.set_ylabel("F_SPH / F_theory(a) [1]")
     bottom.legend(fontsize="small")
     return fig

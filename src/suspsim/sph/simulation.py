@@ -22,6 +22,7 @@ thread count of the resumed run.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import logging
 import time as time_module
@@ -31,6 +32,7 @@ import numpy as np
 
 from suspsim.bodies.coupling import body_force_torque, place_body_particles
 from suspsim.bodies.lubrication_pass import OVERLAPS, SMALLEST_GAP, lubrication_pass
+from suspsim.rheology.laws import make_law
 from suspsim.scene import Scene
 from suspsim.sph import kernels
 from suspsim.sph.boundaries import lees_edwards_offset
@@ -45,7 +47,7 @@ from suspsim.sph.terms.force_pass import FORCE_WIDTH
 from suspsim.sph.terms.shifting import shift_particles
 from suspsim.sph.terms.velocity_pass import GRADIENT_WIDTH
 from suspsim.sph.terms.viscous import bulk_factor, viscous_weights
-from suspsim.sph.timestep import auto_sound_speed, stable_time_step
+from suspsim.sph.timestep import auto_sound_speed, max_viscosity, stable_time_step
 from suspsim.threads import use_threads
 
 log = logging.getLogger(__name__)
@@ -76,6 +78,7 @@ class Simulation:
                                numba.config.NUMBA_NUM_THREADS))
         self._n_chunks = int(_state["n_chunks"]) if _state is not None else self.threads
         law = scene.fluid.law
+        self._law = law
         self._newtonian = bool(law.is_newtonian)
         self._normalise = bool(scene.numerics.viscous_normalisation)
         self._bulk_gradient = bool(scene.numerics.bulk_correction) and not self._newtonian
@@ -114,7 +117,9 @@ class Simulation:
         self.n_particles = int(positions.shape[0])
         self._rho_eq = (reference_count or self.n_particles) * self._mass / scene.volume
         self._lubrication = self._lubrication_setup()
-        self._shifting = float(scene.numerics.shifting)
+        # Shifting acts only with a rate scale (numerics.shifting_rate; auto: the imposed rate).
+        self._shifting_rate = float(scene.numerics.shifting_rate)
+        self._shifting = float(scene.numerics.shifting) if self._shifting_rate > 0.0 else 0.0
         self._mean_reference = scene.numerics.pressure_reference == "fluid_mean"
         if _state is None:
             self.sound_speed = (float(scene.run.sound_speed) if scene.run.sound_speed is not None
@@ -241,7 +246,7 @@ class Simulation:
         s, nl, tb = self.scene, self._nlist, self._table
         return (self._box, nl.start, nl.image_start, nl.neighbours, self._kernel, SUPPORT,
                 self._mass, self._rho_eq, self.sound_speed ** 2, self._rate, self._body_force,
-                s.dimension, s.fluid.law.code, s.fluid.law.packed, self._newtonian,
+                s.dimension, self._law.code, self._law.packed, self._newtonian,
                 self._velocity_gradient, self._normalise, self._alpha, self._beta,
                 self._bulk_factor, self._bulk_gradient, self.bodies is not None, self._body_of,
                 self._rho, self._volume,
@@ -372,7 +377,7 @@ class Simulation:
             if self._shifting > 0.0:
                 tb = self._table
                 shift_particles(self._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
-                                self._volume, self._body_of, self._shifting, self._rate, dt,
+                                self._volume, self._body_of, self._shifting, self._shifting_rate, dt,
                                 SUPPORT, self._gradient, self._grad_c, self._scratch_15,
                                 self._bounds, self._x, self._v)
             if self._mean_reference:
@@ -382,13 +387,47 @@ class Simulation:
     def relax(self, tolerance: float, max_steps: int) -> int:
         """Relax the start; returns the steps taken (scene key ``lattice.relax``).
 
-        The fluid moves under its own pressure and viscous forces with the bodies held still,
-        no imposed flow and velocities damped by :data:`RELAX_DAMPING` per step, until the
+        The fluid moves under its own pressure and viscous forces (a Newtonian viscosity μ_max
+        of the time step, ``timestep.max_viscosity``) with the bodies held still, no imposed
+        flow and velocities damped by :data:`RELAX_DAMPING` per step, until the
         density error is at most ``tolerance`` (checked every :data:`RELAX_CHECK` steps) or
         ``max_steps`` have run. Then time restarts at 0 with the initial velocities of the
         scene (imposed profile or rest) at the relaxed positions.
         """
         rate, self._rate = self._rate, 0.0
+        with self._constant_viscosity(max_viscosity(self.scene)):
+            steps, error = self._relax_steps(tolerance, max_steps)
+        self._rate = rate
+        self._start_flow()
+        log.info("relaxed the start in %d steps: density error %.3g (tolerance %.3g)", steps,
+                 error, tolerance)
+        if error > tolerance:
+            log.warning("the start is still %.3g from rho_eq after lattice.relax_max_steps = %d "
+                        "steps (lattice.relax_tolerance %.3g)", error, max_steps, tolerance)
+        return steps
+
+    @contextlib.contextmanager
+    def _constant_viscosity(self, mu: float):
+        """Run the physics with a Newtonian viscosity ``mu`` inside the block. The relaxation
+        has no imposed flow, so a shear-thinning law would read its zero-rate viscosity, up to
+        10⁶ times the μ_max the time step was chosen for (a yield-stress matrix blew up)."""
+        saved = (self._law, self._newtonian, self._velocity_gradient, self._bulk_gradient,
+                 self._mu.copy(), self._mu_hat.copy())
+        self._law = make_law("newtonian", {"mu": mu})
+        self._newtonian, self._bulk_gradient = True, False
+        self._velocity_gradient = self._normalise
+        self._mu[:] = mu
+        self._mu_hat[:] = mu
+        try:
+            yield
+        finally:
+            (self._law, self._newtonian, self._velocity_gradient, self._bulk_gradient,
+             mu_saved, mu_hat_saved) = saved
+            self._mu[:] = mu_saved
+            self._mu_hat[:] = mu_hat_saved
+
+    def _relax_steps(self, tolerance: float, max_steps: int) -> tuple[int, float]:
+        """The relaxation loop of :meth:`relax`: (steps taken, final density error)."""
         dt = self.dt
         self._v[:] = 0.0
         self._a[:] = 0.0
@@ -413,15 +452,7 @@ class Simulation:
             steps += 1
             if steps % RELAX_CHECK == 0:
                 error = self._density_error()
-        error = self._density_error()
-        self._rate = rate
-        self._start_flow()
-        log.info("relaxed the start in %d steps: density error %.3g (tolerance %.3g)", steps,
-                 error, tolerance)
-        if error > tolerance:
-            log.warning("the start is still %.3g from rho_eq after lattice.relax_max_steps = %d "
-                        "steps (lattice.relax_tolerance %.3g)", error, max_steps, tolerance)
-        return steps
+        return steps, self._density_error()
 
     def _start_flow(self) -> None:
         """Velocities of the scene's start at the current positions; list rebuilt at time 0."""

@@ -2,12 +2,13 @@
 
 After each step every fluid particle moves by
 
-    δr_i = −D ∇C_i,   ∇C_i = Σ_j V_j ∇W(r_ij) = −Σ_j V_j F(r_ij) r_ij,   D = A h² γ̇ δt,
+    δr_i = −D ∇C_i,   ∇C_i = Σ_j V_j ∇W(r_ij) = −Σ_j V_j F(r_ij) r_ij,   D = A h² γ_s δt,
 
 clipped to |δr_i| ≤ :data:`MAX_SHIFT` h, down the gradient of the particle concentration C
 (Lind, Xu, Stansby & Rogers 2012, J. Comput. Phys. 231, 1499, Eq. 15, with their ‖v‖ replaced
-by γ̇ h, the velocity difference across one kernel of the imposed flow, so that D does not depend
-on the frame of the Lees–Edwards box [choice]). Its velocity is carried along the local
+by γ_s h, a velocity difference across one kernel, so that D does not depend on the frame
+[choice]). γ_s is ``numerics.shifting_rate``: the imposed shear rate of a Couette flow by
+default; a flow without one (bodies driven through fluid at rest) names its own scale. Its velocity is carried along the local
 gradient, v_i += δr_i · ∇v_i (Lind's Taylor correction, with the step's corrected gradient).
 Body particles stay rigid; they count in C, so fluid is pushed off dense body shells too.
 
@@ -19,7 +20,7 @@ A = 30 and 0.997 with A = 100 (a lattice start gives 0.991). Numerical only; off
 since a lattice start carries no such structure.
 
 Symbols: V_j = m/ρ_j [h^d]; F = −W'/r [h^−(d+2)]; r_ij = r_i − r_j [h]; A shifting coefficient
-[1] (``numerics.shifting``); h support radius; γ̇ imposed shear rate [τ⁻¹]; δt step [τ].
+[1] (``numerics.shifting``); h support radius; γ_s shifting rate [τ⁻¹]; δt step [τ].
 """
 from __future__ import annotations
 
@@ -80,13 +81,13 @@ def concentration_gradient(start, pair_end, pair_j, geometry, volume, acc, scrat
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def shift_particles(start, pair_end, pair_j, geometry, volume, body_of, coefficient, shear_rate,
+def shift_particles(start, pair_end, pair_j, geometry, volume, body_of, coefficient, rate,
                     dt, h, gradient, grad_c, scratch, bounds, positions, velocities):
     """Shift every fluid particle (module docstring); ``grad_c`` (3N,) scratch ← ∇C,
     ``scratch`` and ``bounds`` those of the chunked pair passes; ``gradient`` (N, 9) the
     step's ∂_k v_l (``terms.gradient``)."""
     concentration_gradient(start, pair_end, pair_j, geometry, volume, grad_c, scratch, bounds)
-    diffusion = coefficient * h * h * abs(shear_rate) * dt
+    diffusion = coefficient * h * h * abs(rate) * dt
     for i in prange(positions.shape[0]):
         if body_of[i] >= 0:
             continue
