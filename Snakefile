@@ -13,6 +13,7 @@ report: "workflow/report/workflow.rst"
 include: "workflow/rules/common.smk"
 include: "workflow/rules/fit.smk"
 include: "workflow/rules/predict.smk"
+include: "workflow/rules/pack.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/gather.smk"
 

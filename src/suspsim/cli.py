@@ -201,8 +201,7 @@ _SAND_ONLY = ("degree", "roughness", "elongation_range")
 
 
 def _cmd_pack(args) -> int:
-    from .bodies.packing import pack
-    from .io.packing_file import write_packing
+    from .stages.pack import describe_packing, pack_to_file
 
     options = {"polydispersity": args.polydispersity, "size_ratio": args.size_ratio,
                "seed": args.seed, "min_gap": args.min_gap, "max_steps": args.max_steps,
@@ -216,17 +215,10 @@ def _cmd_pack(args) -> int:
     if args.elongation is not None:
         options["elongation_range"] = tuple(args.elongation)
     try:
-        packing = pack(args.shape, args.box, args.phi, args.radius, **options)
+        packing = pack_to_file(args.out, args.shape, args.box, args.phi, args.radius, **options)
     except InputError as err:
         raise InputError(_PACK_OPTIONS.get(err.source, err.source), err.problem) from None
-    write_packing(args.out, packing)
-    details = packing.details
-    print(f"packed {packing.count} {args.shape} bodies in a "
-          f"{' x '.join(f'{length:g}' for length in packing.box)} box: volume fraction "
-          f"{packing.volume_fraction:.12g} (asked {args.phi:g}), smallest gap "
-          f"{details['smallest_gap']:.3g} (min {packing.min_gap:.3g}), "
-          f"{details['relaxation_steps']} relaxation steps, {details['wall_time_s']:.2f} s; "
-          f"wrote {args.out}")
+    print(describe_packing(packing, args.phi, args.out))
     return 0
 
 

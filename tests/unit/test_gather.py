@@ -8,10 +8,14 @@ from matplotlib.figure import Figure
 
 from suspsim.errors import InputError
 from suspsim.io.study_variables import STUDY_VARIABLES, SUMMARY_DIMS
-from suspsim.plotting.summary import plot_summary, plot_viscosity, seed_mean
+from suspsim.plotting.summary import (plot_relative_viscosity_vs_phi, plot_summary,
+                                      plot_viscosity, seed_mean)
 from suspsim.rheology.laws import make_law
 from suspsim.stages.gather import gather_runs, write_summary
+from suspsim.stages.homogenisation import homogenisation_estimate
+from suspsim.stages.pack import Particles
 from suspsim.stages.simulate import Resolution, simulation_scene, with_physical_results
+from suspsim.stages.summary_figure import estimate_by_phi
 
 FIT = {"law": "cross", "params": {"mu_0": 50.0, "mu_inf": 0.02, "lam": 2.5, "m": 0.8},
        "source": "synthetic"}
@@ -33,6 +37,23 @@ def fake_run(rate, seed, factor=1.0, stderr=0.002, phi=0.0, fit=FIT):
     return out.assign_coords(phi=out["phi"] * 0 + phi) if phi else out
 
 
+def fake_suspension_run(rate, seed, phi, factor, particles=Particles(radius=1.0)):
+    """A run at φ > 0 as run_scene writes it: its own φ and viscosities in simulation units."""
+    scene, mapping = simulation_scene(LAW, rate, volume_fraction=phi, seed=seed,
+                                      resolution=RESOLUTION, particles=particles)
+    mu_sim = float(scene.fluid.law.viscosity(mapping.simulation_shear_rate))
+    run = xr.Dataset({"viscosity": ((), factor * mu_sim),
+                      "viscosity_stderr": ((), 0.01 * mu_sim), "phi": ((), phi),
+                      "suspension_viscosity": ((), factor * mu_sim),
+                      "relative_viscosity": ((), factor),
+                      "relative_viscosity_stderr": ((), 0.01),
+                      "matrix_viscosity_at_rate": ((), mu_sim)},
+                     attrs={"mach_number": 1e-3, "wall_time_s": 12.0, "n_particles": 480,
+                            "reynolds_number": 0.6, "n_bodies": 3})
+    return with_physical_results(run, mapping, scene=scene, volume_fraction=phi, seed=seed,
+                                 resolution=RESOLUTION, fit=FIT)
+
+
 def test_physical_results_of_one_run():
     run = fake_run(2.0, 1, factor=0.99)
     assert float(run["relative_viscosity"]) == pytest.approx(0.99, rel=1e-12)
@@ -44,6 +65,36 @@ def test_physical_results_of_one_run():
     assert json.loads(run.attrs["resolution"])["box"] == 5
     for name in STUDY_VARIABLES:
         assert run[name].attrs["units"] and run[name].attrs["long_name"]
+
+
+def test_physical_results_of_a_suspension_run_replace_its_simulation_unit_ones():
+    run = fake_suspension_run(2.0, 3, 0.2, 1.7)
+    assert float(run["phi"]) == 0.2 and run["phi"].attrs["units"] == "1"
+    assert float(run["relative_viscosity"]) == pytest.approx(1.7, rel=1e-12)
+    assert float(run["suspension_viscosity"]) == pytest.approx(1.7 * float(LAW.viscosity(2.0)))
+    assert run["suspension_viscosity"].attrs["units"] == "Pa s"
+    assert float(run["body_count"]) == 3 and float(run["packing_seed"]) == 3
+    assert float(run["inclusion_radius"]) == 1.0 == float(run["reynolds_length"])
+    assert np.isnan(float(run["particle_radius"]))
+    assert json.loads(run.attrs["inclusions"]) == {"shape": "sphere", "radius": 1.0,
+                                                   "polydispersity": 0.0, "size_ratio": 5.0,
+                                                   "min_gap": 0.05}
+    alone = fake_run(2.0, 3)
+    assert alone.attrs["inclusions"] == "" and alone.attrs["inclusion_shape"] == "none"
+    assert float(alone["body_count"]) == 0 and np.isnan(float(alone["inclusion_radius"]))
+    assert float(alone["reynolds_length"]) == 1.0
+
+
+def test_gather_carries_the_inclusion_settings_and_refuses_mixed_ones():
+    summary = gather_runs([fake_run(1.0, 1), fake_suspension_run(1.0, 1, 0.2, 1.5)])
+    assert summary.attrs["inclusion_shape"] == "sphere"
+    assert json.loads(summary.attrs["inclusions"])["radius"] == 1.0
+    radius = summary["inclusion_radius"].sel(shear_rate=1.0, seed=1)
+    assert np.isnan(float(radius.sel(phi=0.0))) and float(radius.sel(phi=0.2)) == 1.0
+    assert summary["inclusion_radius"].attrs["simulation_units"] == "h"
+    with pytest.raises(InputError, match="different inclusion settings"):
+        gather_runs([fake_suspension_run(1.0, 1, 0.2, 1.5),
+                     fake_suspension_run(1.0, 1, 0.1, 1.2, Particles(radius=1.2))])
 
 
 def test_gather_builds_the_grid_with_units_and_nan_for_missing_runs():
@@ -110,10 +161,38 @@ def test_summary_figure_draws_runs_law_measurements_and_estimate():
                                                      np.vstack([1.3 * LAW.viscosity(rates)] * 2))},
                           coords={"volume_fraction": [0.1, 0.2], "shear_rate": rates})
     fig = plot_summary(summary, law=LAW, measured=(rates, LAW.viscosity(rates)), estimate=estimate)
-    assert isinstance(fig, Figure) and len(fig.axes) == 2
+    assert isinstance(fig, Figure) and len(fig.axes) == 3
     labels = [line.get_label() for line in fig.axes[0].get_lines()]
     assert "matrix (measured)" in labels and "matrix (cross fit)" in labels
     assert "φ = 0.2 homogenisation estimate" in labels
     assert not any("φ = 0.1" in label for label in labels)
     alone = plot_viscosity(summary)
     assert isinstance(alone, Figure) and len(alone.axes) == 1
+
+
+def test_relative_viscosity_against_phi_beside_the_estimate_at_each_simulated_rate():
+    runs = [fake_run(r, 1) for r in (0.1, 10.0)]
+    runs += [fake_suspension_run(r, 1, phi, 1 + 3 * phi) for r in (0.1, 10.0) for phi in (0.1, 0.3)]
+    summary = gather_runs(runs, material="m")
+    coarse = homogenisation_estimate(FIT, [0.1, 0.2, 0.3, 0.4], np.geomspace(0.01, 100, 9),
+                                     phi_max=0.57)
+    fine = estimate_by_phi(FIT, summary, coarse)
+    assert fine["shear_rate"].values.tolist() == [0.1, 10.0]
+    assert fine["volume_fraction"].values[0] == 0.0
+    assert fine["volume_fraction"].values[-1] == pytest.approx(0.44)
+    fig = plot_relative_viscosity_vs_phi(summary, estimate=fine)
+    ax = fig.axes[0]
+    labels = [line.get_label() for line in ax.get_lines()]
+    assert "γ̇ = 10 1/s, homogenisation estimate" in labels
+    assert "Krieger–Dougherty g(φ) (Newtonian matrix)" in labels
+    curve = next(line for line in ax.get_lines()
+                 if line.get_label() == "γ̇ = 0.1 1/s, homogenisation estimate")
+    expected = fine["relative_viscosity"].sel(shear_rate=0.1).values
+    np.testing.assert_allclose(curve.get_ydata(), expected)
+    # From the coarse estimate, interpolated in log rate (10 1/s is on its grid: exact).
+    fig = plot_relative_viscosity_vs_phi(summary, estimate=coarse)
+    curve = next(line for line in fig.axes[0].get_lines()
+                 if line.get_label() == "γ̇ = 10 1/s, homogenisation estimate")
+    assert curve.get_xdata().tolist() == [0.0, 0.1, 0.2, 0.3, 0.4]
+    exact = homogenisation_estimate(FIT, [0.3], [10.0], phi_max=0.57)["relative_viscosity"]
+    assert curve.get_ydata()[3] == pytest.approx(float(exact.squeeze()), rel=1e-9)

@@ -1,6 +1,7 @@
 """The Snakemake workflow: config validation, drop-in materials, the fit stage and the smoke
 study (fit, homogenisation, simulate, gather, plot) end to end, and what a change re-runs."""
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -9,6 +10,7 @@ from pathlib import Path
 
 import pytest
 import xarray as xr
+import yaml
 
 REPO = Path(__file__).resolve().parents[2]
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
@@ -27,9 +29,9 @@ def _study(tmp_path, materials):
     return tmp_path
 
 
-def _run(cwd, *args, cores="1"):
+def _run(cwd, *args, cores="1", env=None):
     return subprocess.run([*SNAKEMAKE, "--cores", cores, *args], cwd=cwd, capture_output=True,
-                          text=True)
+                          text=True, env=env)
 
 
 def _fit_targets(name):
@@ -116,13 +118,98 @@ def test_smoke_study_end_to_end_then_nothing_then_only_the_changed_rate(tmp_path
                                                 "all": 1}
 
 
-def test_volume_fraction_above_zero_fails_its_job_naming_the_missing_capability(tmp_path):
+def _dry_jobs(proc, rule):
+    """The wildcards of each job of ``rule`` in a dry run's listing, as dicts."""
+    found, current = [], None
+    for line in (proc.stdout + proc.stderr).splitlines():
+        header = re.match(r"^(?:local)?rule (\w+):$", line)
+        if header:
+            current = header[1]
+        elif current == rule and line.strip().startswith("wildcards: "):
+            found.append(dict(item.split("=") for item in
+                              line.strip().removeprefix("wildcards: ").split(", ")))
+    return found
+
+
+def _placeholders(study, *args):
+    """Empty files for every output a dry run lists, then all marked up to date with their
+    metadata recorded (snakemake --touch --forceall): what a finished study looks like to the
+    next dry run, without running it. (Without the metadata a dry run does not see that gather
+    needs a new run file: it finds the new column through the changed set of gather's inputs.)"""
+    dry = _run(study, "-n", *args)
+    for line in re.findall(r"^\s+output: (.*)$", dry.stdout + dry.stderr, re.MULTILINE):
+        for name in line.split(", "):
+            (study / name).parent.mkdir(parents=True, exist_ok=True)
+            (study / name).touch()
+    assert _run(study, "--touch", "--forceall", *args).returncode == 0
+
+
+def test_spheres_study_packs_each_phi_and_seed_once_through_the_cache(tmp_path):
+    study = _study(tmp_path / "a", {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    env = {**os.environ, "SNAKEMAKE_OUTPUT_CACHE": str(cache)}
+    spheres = ["--configfile", "config/studies/spheres.yaml"]
+    dry = _run(study, "-n", "--cache", *spheres, env=env)
+    assert dry.returncode == 0, dry.stderr
+    config = yaml.safe_load((study / "config/studies/spheres.yaml").read_text())["simulation"]
+    packs = _dry_jobs(dry, "pack")
+    wanted = {(f"{phi:g}", str(seed)) for phi in config["volume_fractions"] if phi > 0
+              for seed in config["seeds"]}
+    assert sorted((job["phi"], job["seed"]) for job in packs) == sorted(wanted)
+    text = dry.stdout + dry.stderr
+    assert text.count("will be written to global between-workflow cache") == len(wanted)
+    runs = {(job["phi"], job["rate"], job["seed"]) for job in _dry_jobs(dry, "simulate")}
+    assert len(runs) == len(_dry_jobs(dry, "simulate")) == (
+        len(config["volume_fractions"]) * len(config["shear_rates"]) * len(config["seeds"]))
+    # Packed once for real; a second workflow with the same settings (another material name:
+    # wildcards are not part of the cache hash) takes the files from the cache.
+    assert _run(study, "--cache", "--until", "pack", *spheres, env=env).returncode == 0
+    packing = study / "results/linear_polymer/packings/phi-0.2_seed-1.nc"
+    assert packing.is_symlink() and Path(os.readlink(packing)).parent == cache
+    other = _study(tmp_path / "b", {"other": REPO / "data/linear_polymer/matrix.csv"})
+    for path in (other / "config/studies/spheres.yaml",):
+        path.write_text(path.read_text().replace("[linear_polymer]", "[other]"))
+    dry = _run(other, "-n", "--cache", *spheres, env=env)
+    assert (dry.stdout + dry.stderr).count("will be obtained from global between-workflow "
+                                           "cache") == len(wanted)
+    # A material sheet's particle settings are pack params: a new cache entry.
+    (other / "data/other/material.yaml").write_text("particles: {polydispersity: 0.2}\n")
+    dry = _run(other, "-n", "--cache", *spheres, env=env)
+    assert (dry.stdout + dry.stderr).count("will be written to global between-workflow "
+                                           "cache") == len(wanted)
+
+
+def test_changing_one_volume_fraction_reruns_only_its_column(tmp_path):
+    study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
+    spheres = ["--configfile", "config/studies/spheres.yaml"]
+    _placeholders(study, *spheres)
+    assert "Nothing to be done" in _run(study, "-n", *spheres).stdout
+    config = study / "config/studies/spheres.yaml"
+    text = config.read_text()
+    config.write_text(text.replace("[0.0, 0.1, 0.2, 0.3]", "[0.0, 0.1, 0.2, 0.25]"))
+    dry = _run(study, "-n", *spheres)
+    rates = yaml.safe_load(text)["simulation"]["shear_rates"]
+    assert _jobs(dry) == {"pack": 1, "simulate": len(rates), "gather": 1, "plot_summary": 1,
+                          "all": 1}
+    assert {job["phi"] for job in _dry_jobs(dry, "simulate")} == {"0.25"}
+
+
+def test_a_suspension_run_goes_through_pack_and_simulate(tmp_path):
     study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
     config = study / "config/studies/smoke.yaml"
     config.write_text(config.read_text().replace("volume_fractions: [0.0]",
-                                                 "volume_fractions: [0.3]"))
-    target = "results/linear_polymer/runs/phi-0.3_rate-0.1_seed-1.nc"
+                                                 "volume_fractions: [0.1]")
+                      + "  inclusions: {radius: 1.0}\n")
+    (study / "data/linear_polymer/material.yaml").write_text("particles: {radius_m: 5.0e-5}\n")
+    target = "results/linear_polymer/runs/phi-0.1_rate-0.1_seed-1.nc"
     proc = _run(study, target, "--configfile", "config/studies/smoke.yaml")
-    assert proc.returncode != 0
-    log = (study / "logs/simulate/linear_polymer/phi-0.3_rate-0.1_seed-1.log").read_text()
-    assert "rigid inclusions" in log
+    assert proc.returncode == 0, proc.stderr
+    assert (study / "logs/pack/linear_polymer/phi-0.1_seed-1.log").exists()
+    with xr.open_dataset(study / target) as run:
+        assert float(run["phi"]) == 0.1 and float(run["body_count"]) >= 1
+        assert float(run["inclusion_radius"]) == 1.0 and float(run["packing_seed"]) == 1
+        assert float(run["particle_radius"]) == pytest.approx(5e-5)
+        assert run.attrs["inclusion_shape"] == "sphere"
+        assert json.loads(run.attrs["scene"])["inclusions"]["packing"] == (
+            "results/linear_polymer/packings/phi-0.1_seed-1.nc")

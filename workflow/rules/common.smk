@@ -9,6 +9,7 @@ from snakemake.utils import validate
 from suspsim.errors import SuspsimError
 from suspsim.io.provenance import code_version
 from suspsim.rheology.readers import read_flow_curve
+from suspsim.stages.pack import particle_settings
 
 
 validate(config, "../schemas/config.schema.yaml")
@@ -28,6 +29,7 @@ wildcard_constraints:
 CODE = {
     "fit_matrix": code_version("suspsim.stages.fit"),
     "predict_homogenisation": code_version("suspsim.stages.homogenisation"),
+    "pack": code_version("suspsim.stages.pack"),
     "simulate": code_version("suspsim.stages.simulate"),
     "gather": code_version("suspsim.stages.gather"),
     "plot_summary": code_version("suspsim.stages.summary_figure", "suspsim.plotting.summary"),
@@ -67,11 +69,14 @@ def _load_material_sheet(material):
     sheet.setdefault("matrix", {})
     sheet["matrix"].setdefault("sample", None)
     sheet["matrix"].setdefault("law", None)
+    sheet.setdefault("particles", {})
     return sheet
 
 
 MATRIX_FILES = _discover_materials()
 MATERIALS = {m: _load_material_sheet(m) for m in MATRIX_FILES}
+PARTICLES = {m: particle_settings(SIMULATION["inclusions"], MATERIALS[m]["particles"]).to_dict()
+             for m in MATERIALS}
 
 
 def matrix_file(wildcards):
@@ -127,6 +132,24 @@ def run_files(wildcards):
             for phi in SIMULATION["volume_fractions"]
             for rate in SHEAR_RATES[wildcards.material]
             for seed in SIMULATION["seeds"]]
+
+
+def run_packing(wildcards):
+    """The packing file a run at phi > 0 reads; none for the matrix alone."""
+    if float(wildcards.phi) == 0:
+        return []
+    return f"{RESULTS}/{wildcards.material}/packings/phi-{wildcards.phi}_seed-{wildcards.seed}.nc"
+
+
+def run_particles(wildcards):
+    """The material's inclusion settings for a run at phi > 0 (None at phi = 0, so that
+    changing them leaves the matrix runs alone)."""
+    return PARTICLES[wildcards.material] if float(wildcards.phi) > 0 else None
+
+
+def pack_particles(wildcards):
+    """The material's particle settings that shape its packings (the physical radius does not)."""
+    return {k: v for k, v in PARTICLES[wildcards.material].items() if k != "physical_radius"}
 
 
 def run_shear_rate(wildcards):

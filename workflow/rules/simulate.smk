@@ -1,9 +1,11 @@
-# Stage 3: one SPH simulation per material x volume fraction x shear rate x seed (SPEC 2.7, 7).
+# Stage 3: one SPH simulation per material x volume fraction x shear rate x seed (SPEC 2.7, 7);
+# at phi > 0 on the packing of its phi and seed (rule pack).
 
 
 rule simulate:
     input:
         fit=f"{RESULTS}/{{material}}/fit.json",
+        packing=run_packing,
     output:
         run=f"{RESULTS}/{{material}}/runs/phi-{{phi}}_rate-{{rate}}_seed-{{seed}}.nc",
     log:
@@ -16,6 +18,7 @@ rule simulate:
         volume_fraction=run_volume_fraction,
         seed=run_seed,
         resolution=RESOLUTION,
+        particles=run_particles,
         code=CODE["simulate"],
     script:
         "../scripts/simulate.py"

@@ -70,4 +70,17 @@ STUDY_VARIABLES: Mapping[str, StudyVariable] = MappingProxyType({v.name: v for v
     StudyVariable("mach_number", "1", "largest Mach number |v - v_imposed|/c during the run"),
     StudyVariable("time_scale", "s", "physical duration of the simulation time unit tau"),
     StudyVariable("viscosity_scale", "Pa s", "physical value of the simulation viscosity unit"),
+    StudyVariable("reynolds_length", "1", "length l of particle_reynolds_number",
+                  simulation_units="h", comment="1 h for the matrix alone, inclusion_radius with "
+                                                "inclusions"),
+    StudyVariable("inclusion_radius", "1", "nominal mean volume-equivalent radius of the rigid "
+                  "inclusions", simulation_units="h", comment="NaN at phi = 0 (no inclusions); "
+                  "the packing rescales it by a factor near 1 to reach phi exactly"),
+    StudyVariable("packing_seed", "1", "seed of the random packing of the inclusions",
+                  comment="NaN at phi = 0 (no packing)"),
+    StudyVariable("body_count", "1", "number of rigid inclusions in the box"),
+    StudyVariable("particle_radius", "m", "physical mean radius of the inclusions",
+                  comment="from the material sheet (particles.radius_m); NaN when it gives none "
+                          "or at phi = 0. It sets the length scale particle_radius/"
+                          "inclusion_radius of the run"),
 )})

@@ -7,7 +7,11 @@ errors and the spread between seeds,
     η̄ = (1/n) Σ η_i,    s² = (1/n²) Σ s_i² + Var_seeds(η)/n    (Var = 0 for one seed),
 
 drawn over the fitted matrix law (line), the measured matrix points (open circles) and, for φ > 0,
-the homogenisation estimate of the same φ (dashed) when one is given. No file I/O here.
+the homogenisation estimate of the same φ (dashed) when one is given. The relative viscosity
+η_r = η/μ_m(γ̇) is drawn against γ̇ per φ (φ = 0 checks the solver: 1) and against φ per γ̇, there
+beside the estimate's η_r(φ) at each simulated rate (dashed, interpolated in log γ̇ when the
+estimate's rates differ) and its Newtonian limit, Krieger–Dougherty g(φ) (dotted). No file I/O
+here.
 """
 from __future__ import annotations
 
@@ -15,6 +19,7 @@ from typing import Sequence
 
 import numpy as np
 import xarray as xr
+from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
@@ -24,6 +29,10 @@ from ..rheology.laws import ConstitutiveLaw
 EXTEND = 2.0
 #: Two volume fractions closer than this are the same φ when matching an estimate [1].
 PHI_TOLERANCE = 1e-9
+#: A simulated rate this close (relative) outside the estimate's rates is still inside [1].
+RATE_TOLERANCE = 1e-9
+#: Colour map of the shear rates in the η_r(φ) panel, low rate dark.
+RATE_COLOURS = "viridis"
 
 
 def seed_mean(summary: xr.Dataset, name: str) -> tuple[xr.DataArray, xr.DataArray]:
@@ -86,14 +95,54 @@ def plot_relative_viscosity(summary: xr.Dataset, ax: Axes | None = None) -> Figu
     return fig
 
 
+def plot_relative_viscosity_vs_phi(summary: xr.Dataset, ax: Axes | None = None, *,
+                                   estimate: xr.Dataset | None = None) -> Figure:
+    """Relative viscosity η/μ_matrix(γ̇) [1] vs volume fraction φ [1], one colour per shear rate
+    (from :data:`RATE_COLOURS`, so that they differ from the φ colours of the other panels).
+
+    ``estimate`` a homogenisation Dataset (dims volume_fraction, shear_rate, with
+    ``relative_viscosity`` and ``newtonian_relative_viscosity``), best on a fine φ grid: its
+    η_r(φ) at each simulated rate is drawn dashed, g(φ) dotted (module docstring).
+    """
+    fig, ax = _figure_and_axes(ax)
+    phis = summary["phi"].values
+    mean, error = seed_mean(summary, "relative_viscosity")
+    rates = summary["shear_rate"].values
+    colours = colormaps[RATE_COLOURS](np.linspace(0.0, 0.85, rates.size))
+    for rate, colour in zip(rates, colours):
+        ax.errorbar(phis, mean.sel(shear_rate=rate).values,
+                    yerr=error.sel(shear_rate=rate).values, fmt="o", color=colour, ms=5,
+                    capsize=3, label=f"γ̇ = {rate:g} 1/s, SPH")
+        curve = _estimate_at_rate(estimate, rate)
+        if curve is not None:
+            ax.plot(curve["volume_fraction"].values, curve.values, "--", color=colour, lw=1,
+                    label=f"γ̇ = {rate:g} 1/s, homogenisation estimate")
+    if estimate is not None and "newtonian_relative_viscosity" in estimate:
+        g = estimate["newtonian_relative_viscosity"]
+        ax.plot(g["volume_fraction"].values, g.values, ":", color="k", lw=1,
+                label="Krieger–Dougherty g(φ) (Newtonian matrix)")
+    ax.axhline(1.0, color="0.6", lw=0.8)
+    ax.set(xlabel="volume fraction φ [1]", ylabel="relative viscosity η/μ_matrix(γ̇) [1]")
+    ax.set_xlim(left=0.0)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=7)
+    return fig
+
+
 def plot_summary(summary: xr.Dataset, *, law: ConstitutiveLaw | None = None,
                  measured: tuple[Sequence[float], Sequence[float]] | None = None,
-                 estimate: xr.Dataset | None = None) -> Figure:
-    """Two panels: :func:`plot_viscosity` and :func:`plot_relative_viscosity`."""
-    fig = Figure(figsize=(10, 4.2), layout="constrained")
-    ax_eta, ax_rel = fig.subplots(1, 2)
+                 estimate: xr.Dataset | None = None,
+                 estimate_by_phi: xr.Dataset | None = None) -> Figure:
+    """Three panels: :func:`plot_viscosity` (with ``estimate``), :func:`plot_relative_viscosity`
+    and :func:`plot_relative_viscosity_vs_phi` (with ``estimate_by_phi``, default ``estimate``)."""
+    fig = Figure(figsize=(15, 4.4), layout="constrained")
+    ax_eta, ax_rel, ax_phi = fig.subplots(1, 3)
     plot_viscosity(summary, ax_eta, law=law, measured=measured, estimate=estimate)
     plot_relative_viscosity(summary, ax_rel)
+    plot_relative_viscosity_vs_phi(summary, ax_phi,
+                                   estimate=estimate if estimate_by_phi is None
+                                   else estimate_by_phi)
     material = summary.attrs.get("material")
     fig.suptitle(f"SPH simulations{f' of {material}' if material else ''}: "
                  f"{int(summary.attrs.get('n_runs', 0))} run(s), mean over seeds ± error")
@@ -111,6 +160,27 @@ def _phi_label(phi: float, summary: xr.Dataset) -> str:
     seeds = int(summary["suspension_viscosity"].sel(phi=phi).notnull().any("shear_rate").sum())
     what = "matrix alone" if phi == 0 else "suspension"
     return f"φ = {phi:g}, SPH ({what}, {seeds} seed{'s' if seeds != 1 else ''})"
+
+
+def _estimate_at_rate(estimate: xr.Dataset | None, rate: float) -> xr.DataArray | None:
+    """The estimate's η_r(φ) at shear rate ``rate``, interpolated in log γ̇, with (0, 1)
+    added when the estimate starts above φ = 0; None outside its rates or without one."""
+    if estimate is None or "relative_viscosity" not in estimate:
+        return None
+    relative = estimate["relative_viscosity"]
+    rates = relative["shear_rate"].values
+    if not rates.min() * (1 - RATE_TOLERANCE) <= rate <= rates.max() * (1 + RATE_TOLERANCE):
+        return None
+    if rates.size == 1:
+        curve = relative.isel(shear_rate=0, drop=True)
+    else:
+        logged = relative.assign_coords(shear_rate=np.log10(rates))
+        curve = logged.interp(shear_rate=np.log10(rate)).drop_vars("shear_rate")
+    curve = curve.sortby("volume_fraction")
+    if curve["volume_fraction"].values[0] > 0:
+        start = xr.DataArray([1.0], coords={"volume_fraction": [0.0]}, dims="volume_fraction")
+        curve = xr.concat([start, curve], dim="volume_fraction")
+    return curve
 
 
 def _estimate_curve(estimate: xr.Dataset | None, phi: float) -> xr.DataArray | None:

@@ -6,7 +6,10 @@ cell and merges them with xarray (outer join), so a missing combination is NaN a
 not be complete. Variables and their units come from
 :data:`~suspsim.io.study_variables.STUDY_VARIABLES`: suspension and relative viscosity with their
 standard errors [Pa s, 1], the matrix viscosity of the fitted law [Pa s], wall time [s], the
-resolution (particles, box side, number density, strain), Re, Mach and the unit scales (SPEC §7).
+resolution (particles, box side, number density, strain), Re, Mach and the unit scales (SPEC §7),
+and the inclusions' radius [h], packing seed, body count and physical radius [m] (NaN at φ = 0).
+The inclusion settings every run with inclusions shares (shape, radius, polydispersity, size
+ratio, gap) become the attributes ``inclusions`` (JSON) and ``inclusion_shape``.
 
 Summary statistics over seeds (mean and spread) belong to the reader; the summary keeps every run.
 """
@@ -39,9 +42,9 @@ def gather_runs(runs: Iterable[xr.Dataset], *, material: str | None = None,
 
     ``sources`` names each run for error messages (default its position). Raises InputError
     for a run without the physical results, two runs of the same (φ, γ̇, seed), runs of
-    different matrix fits, or no run at all.
+    different matrix fits or inclusion settings, or no run at all.
     """
-    cells, fits = [], set()
+    cells, fits, inclusions = [], set(), set()
     runs = list(runs)
     sources = list(sources) if sources is not None else [f"run {i}" for i in range(len(runs))]
     if not runs:
@@ -56,10 +59,17 @@ def gather_runs(runs: Iterable[xr.Dataset], *, material: str | None = None,
             raise InputError(source, f"same (phi, shear_rate, seed) = {key} as {seen[key]}")
         seen[key] = source
         fits.add(run.attrs.get("matrix_fit", ""))
+        if run.attrs.get("inclusions"):
+            inclusions.add(run.attrs["inclusions"])
         cells.append(_cell(run))
     if len(fits) > 1:
         raise InputError(material or "gather", "the runs come from different matrix fits; "
                          "re-run the simulate stage after the fit changed")
+    if len(inclusions) > 1:
+        raise InputError(material or "gather", "the runs have different inclusion settings "
+                         f"({'; '.join(sorted(inclusions))}); re-run the pack and simulate "
+                         "stages after they changed")
+    settings = inclusions.pop() if inclusions else ""
     summary = xr.merge(cells, join="outer", compat="no_conflicts", combine_attrs="drop")
     summary = summary.sortby(list(SUMMARY_DIMS))
     summary = summary.assign_coords(seed=summary["seed"].astype(np.int64))
@@ -75,6 +85,8 @@ def gather_runs(runs: Iterable[xr.Dataset], *, material: str | None = None,
                    f"of {len(runs)} run(s)",
         "material": material or "",
         "matrix_fit": fits.pop(),
+        "inclusions": settings,
+        "inclusion_shape": json.loads(settings)["shape"] if settings else "none",
         "n_runs": len(runs),
         "runs": json.dumps([os.path.basename(s) for s in sources]),
     }

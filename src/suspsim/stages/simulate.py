@@ -13,12 +13,16 @@ holding the run in simulation units plus its results converted back:
 with standard errors from the run's batch means. At φ = 0 the box holds the matrix alone, so
 η_r = 1 within its error checks the solver against the fitted law at each rate.
 
+At φ > 0 the scene holds rigid inclusions (:class:`~suspsim.stages.pack.Particles`, scene key
+``inclusions``), read from the run's packing file (:mod:`suspsim.stages.pack`) when one is
+given, else packed by the scene itself from the same keys, which gives the same packing. The
+particle Reynolds number then takes the inclusion radius a [h] as its length (SPEC §7), and a
+physical particle radius [m], when known, sets the length scale. The dense suspension
+viscosity is not validated yet (README, Suspensions): the Einstein limit passes.
+
 The run starts from the linear profile (``run.start = linear``): the step is then limited by
 μ(γ̇/2) rather than the zero-rate viscosity (:mod:`suspsim.sph.timestep`), which for a
 yield-stress matrix is many orders of magnitude cheaper.
-
-Rigid inclusions (φ > 0) run in the solver but are not validated yet (README, Suspensions):
-:func:`simulation_scene` raises :class:`InclusionsNotAvailable`.
 """
 from __future__ import annotations
 
@@ -31,25 +35,30 @@ from typing import Any, Mapping
 
 import xarray as xr
 
-from ..errors import InputError, SuspsimError
+from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.checkpoint import load_checkpoint
 from ..io.netcdf import read_run
+from ..io.packing_file import read_packing
 from ..io.study_variables import STUDY_VARIABLES
 from ..rheology.laws import ConstitutiveLaw, make_law
 from ..run import checkpoint_path, run_scene
 from ..scene import Scene, scene_from_dict
 from ..units import DEFAULT_REYNOLDS, UnitMapping, unit_mapping
+from .pack import STUDY_MIN_GAP, Particles
 
 log = logging.getLogger(__name__)
 
 #: Suffix of the simulation-unit run file written by run_scene before the physical results are
 #: added; its checkpoint (``+ .ckpt.npz``) lets an interrupted job resume.
 SIMULATION_SUFFIX = ".sim.nc"
-
-
-class InclusionsNotAvailable(SuspsimError, NotImplementedError):
-    """φ > 0: the solver builds rigid inclusions, but their viscosity is not validated yet."""
+#: Results of a run with inclusions that :func:`with_physical_results` replaces by their
+#: physical-unit study variables of the same names (the run's are in simulation units).
+REPLACED_RUN_RESULTS = ("phi", "suspension_viscosity", "relative_viscosity",
+                        "relative_viscosity_stderr")
+#: Largest |φ_packing − φ| accepted between a run's packing and its nominal φ [1]: packings
+#: reach φ to round-off (:mod:`suspsim.bodies.packing`).
+PHI_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -99,23 +108,37 @@ def read_fit(path: str | os.PathLike) -> dict:
 
 
 def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction: float,
-                     seed: int, resolution: Resolution,
-                     threads: int | None = 1) -> tuple[Scene, UnitMapping]:
+                     seed: int, resolution: Resolution, threads: int | None = 1,
+                     particles: Particles | None = None,
+                     packing: str | os.PathLike | None = None) -> tuple[Scene, UnitMapping]:
     """The Couette scene of physical ``shear_rate`` [1/s] for ``law`` (SI) and its mapping.
 
-    Raises :class:`InclusionsNotAvailable` for ``volume_fraction`` > 0, InputError for a bad
-    rate, φ, seed or resolution (e.g. a box that is not a whole number of lattice spacings).
+    φ > 0: inclusions of ``particles`` (default :class:`Particles`()) packed with the run's
+    ``seed`` and gap :data:`~suspsim.stages.pack.STUDY_MIN_GAP`, read from the file
+    ``packing`` when given (it is not opened here); the Reynolds length is their radius [h].
+    Raises InputError for a bad rate, φ, seed or resolution (e.g. a box that is not a whole
+    number of lattice spacings) or a packing at φ = 0.
     """
     if not 0.0 <= volume_fraction < 1.0:
         raise InputError("simulation", f"volume fraction {volume_fraction!r} must be in [0, 1)")
+    if volume_fraction == 0 and packing is not None:
+        raise InputError(packing, "a packing file for a run at volume fraction 0")
+    particles = particles or Particles()
+    length = {}
     if volume_fraction > 0:
-        raise InclusionsNotAvailable(
-            f"volume fraction {volume_fraction:g}: the solver runs rigid inclusions (scene key "
-            "'inclusions'), but their suspension viscosity is not validated yet (the Einstein "
-            "limit fails, see the README), so the workflow simulates phi = 0 only for now")
+        length["reynolds_length"] = particles.radius
+        if particles.physical_radius is not None:
+            length.update(particle_size=particles.physical_radius,
+                          particle_radius=particles.radius)
     mapping = unit_mapping(law, shear_rate, density=resolution.number_density,
-                           reynolds_number=resolution.reynolds)
+                           reynolds_number=resolution.reynolds, **length)
     sim_law = mapping.law_to_simulation(law)
+    inclusions = {"phi": float(volume_fraction)}
+    if volume_fraction > 0:
+        inclusions.update(shape=particles.shape, radius=particles.radius,
+                          polydispersity=particles.polydispersity,
+                          size_ratio=particles.size_ratio, min_gap=STUDY_MIN_GAP,
+                          seed=int(seed), packing=None if packing is None else str(packing))
     data = {"dimension": 3, "box": [resolution.box] * 3,
             "number_density": resolution.number_density,
             "fluid": {"law": sim_law.name, "params": dict(sim_law.params)},
@@ -123,38 +146,48 @@ def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction
             "run": {"strain": resolution.strain, "transient": resolution.transient,
                     "start": "linear", "threads": "all" if threads is None else int(threads)},
             "lattice": {"jitter": resolution.jitter},
-            "inclusions": {"phi": float(volume_fraction)},
+            "inclusions": inclusions,
             "seed": int(seed)}
     return scene_from_dict(data, source="simulation resolution"), mapping
 
 
 def simulate_run(fit_json: str | os.PathLike, out_nc: str | os.PathLike, *, shear_rate: float,
                  volume_fraction: float, seed: int, resolution: Mapping[str, Any] | Resolution,
-                 threads: int | None = 1) -> xr.Dataset:
+                 threads: int | None = 1,
+                 particles: Mapping[str, Any] | Particles | None = None,
+                 packing: str | os.PathLike | None = None) -> xr.Dataset:
     """Simulate one (φ, γ̇, seed) of the matrix in ``fit_json`` and write ``out_nc`` atomically.
 
-    The simulation-unit run goes first to ``out_nc`` with :data:`SIMULATION_SUFFIX` (and its
-    checkpoint); a checkpoint of the same scene left by an interrupted job is resumed, one of
-    another scene is discarded. Returns the written Dataset.
+    ``particles`` and ``packing`` as :func:`simulation_scene` (φ > 0); a packing file must
+    hold the scene's shape, φ, seed and box. The simulation-unit run goes first to ``out_nc``
+    with :data:`SIMULATION_SUFFIX` (and its checkpoint); a checkpoint of the same scene left
+    by an interrupted job is resumed, one of another scene is discarded. Returns the written
+    Dataset.
 
-    Raises InputError (fit report, parameters), :class:`InclusionsNotAvailable` (φ > 0),
-    NumericalError (blow-up; the checkpoint is kept) or :class:`suspsim.run.RunInterrupted`.
+    Raises InputError (fit report, parameters, a packing of other settings), NumericalError
+    (blow-up; the checkpoint is kept) or :class:`suspsim.run.RunInterrupted`.
     """
     fit = read_fit(fit_json)
     law = make_law(fit["law"], fit["params"])
     if not isinstance(resolution, Resolution):
         resolution = Resolution.from_mapping(resolution)
+    if particles is not None and not isinstance(particles, Particles):
+        particles = Particles.from_mapping(particles)
     scene, mapping = simulation_scene(law, shear_rate, volume_fraction=volume_fraction,
-                                      seed=seed, resolution=resolution, threads=threads)
+                                      seed=seed, resolution=resolution, threads=threads,
+                                      particles=particles, packing=packing)
+    if packing is not None:
+        check_packing(packing, scene)
     low, high = fit.get("shear_rate_range", (shear_rate, shear_rate))
     if not low <= shear_rate <= high:
         log.warning("shear rate %g 1/s lies outside the measured range %g–%g 1/s: the matrix law "
                     "is extrapolated", shear_rate, low, high)
     out = Path(out_nc)
     sim_path = out.with_suffix(SIMULATION_SUFFIX)
-    log.info("%s at %g 1/s: time scale %.4g s/tau, viscosity scale %.4g Pa s, particle Re %g; "
-             "law in simulation units %s", law.name, shear_rate, mapping.time_scale,
-             mapping.viscosity_scale, mapping.reynolds_number, dict(scene.fluid.law.params))
+    log.info("%s at %g 1/s: time scale %.4g s/tau, viscosity scale %.4g Pa s, particle Re %g "
+             "(length %g h); law in simulation units %s", law.name, shear_rate,
+             mapping.time_scale, mapping.viscosity_scale, mapping.reynolds_number,
+             mapping.reynolds_length, dict(scene.fluid.law.params))
     run_scene(scene, sim_path, resume=_resumable(sim_path, scene), threads=threads)
     run = read_run(sim_path)
     dataset = with_physical_results(run, mapping, scene=scene, volume_fraction=volume_fraction,
@@ -170,16 +203,47 @@ def simulate_run(fit_json: str | os.PathLike, out_nc: str | os.PathLike, *, shea
     return dataset
 
 
+def check_packing(path: str | os.PathLike, scene: Scene) -> None:
+    """InputError unless the packing file holds the shape, φ, seed and box of ``scene``'s
+    inclusions (a stale or foreign file would silently change the run)."""
+    packing, spec = read_packing(path), scene.inclusions
+    found = {"shape": packing.shape, "seed": packing.seed,
+             "polydispersity": packing.polydispersity, "size_ratio": packing.size_ratio}
+    wanted = {"shape": spec.shape, "seed": spec.seed, "polydispersity": spec.polydispersity,
+              "size_ratio": spec.size_ratio}
+    wrong = [f"{name} {found[name]!r} (the run's {wanted[name]!r})" for name in found
+             if found[name] != wanted[name]]
+    if abs(packing.volume_fraction - spec.phi) > PHI_TOLERANCE:
+        wrong.append(f"volume fraction {packing.volume_fraction:.12g} (the run's {spec.phi:g})")
+    if [float(length) for length in packing.box] != list(scene.box):
+        wrong.append(f"box {list(packing.box)} (the run's {list(scene.box)})")
+    if wrong:
+        raise InputError(path, f"packing of other settings: {'; '.join(wrong)}; re-run its "
+                         "pack job")
+
+
 def with_physical_results(run: xr.Dataset, mapping: UnitMapping, *, scene: Scene,
                           volume_fraction: float, seed: int, resolution: Resolution,
                           fit: Mapping) -> xr.Dataset:
     """``run`` (simulation units) plus its results in physical units and the unit mapping.
 
     Adds the 0-d variables of :data:`~suspsim.io.study_variables.STUDY_VARIABLES` (φ, γ̇ and
-    seed as scalar coordinates, so gathered runs combine by coordinate) and the mapping as
-    ``unit_*`` global attributes, with the run's Mach number.
+    seed as scalar coordinates, so gathered runs combine by coordinate; the inclusions' radius
+    [h], packing seed, body count and physical radius [m], NaN where they do not apply), the
+    mapping as ``unit_*`` global attributes, with the run's Mach number, and the inclusion
+    settings as the JSON attribute ``inclusions`` ("" at φ = 0) and ``inclusion_shape``. A
+    run with inclusions has its own φ and viscosities in simulation units
+    (:data:`REPLACED_RUN_RESULTS`): they are replaced once its φ is checked.
     """
     mapping = mapping.with_mach(float(run.attrs["mach_number"]))
+    spec = scene.inclusions
+    if spec.present:
+        packed = float(run["phi"])
+        if abs(packed - volume_fraction) > PHI_TOLERANCE:
+            raise ValueError(f"the run's packing has phi = {packed:.12g}, not the study's "
+                             f"{volume_fraction:g}")
+        run = run.drop_vars([name for name in REPLACED_RUN_RESULTS if name in run.variables])
+    nan = float("nan")
     mu_sim = float(scene.fluid.law.viscosity(mapping.simulation_shear_rate))
     eta_sim, err_sim = float(run["viscosity"]), float(run["viscosity_stderr"])
     values = {"suspension_viscosity": float(mapping.viscosity_to_physical(eta_sim)),
@@ -194,7 +258,13 @@ def with_physical_results(run: xr.Dataset, mapping: UnitMapping, *, scene: Scene
               "particle_reynolds_number": mapping.reynolds_number,
               "reynolds_number": float(run.attrs["reynolds_number"]),
               "mach_number": mapping.mach_number,
-              "time_scale": mapping.time_scale, "viscosity_scale": mapping.viscosity_scale}
+              "time_scale": mapping.time_scale, "viscosity_scale": mapping.viscosity_scale,
+              "reynolds_length": mapping.reynolds_length,
+              "inclusion_radius": spec.radius if spec.present else nan,
+              "packing_seed": float(spec.seed) if spec.present else nan,
+              "body_count": float(run.attrs.get("n_bodies", 0)),
+              "particle_radius": (spec.radius * mapping.length_scale
+                                  if spec.present and mapping.length_scale is not None else nan)}
     coords = {"phi": float(volume_fraction), "shear_rate": mapping.shear_rate, "seed": int(seed)}
     clashes = sorted((set(values) | set(coords)) & set(run.variables))
     if clashes:
@@ -206,10 +276,17 @@ def with_physical_results(run: xr.Dataset, mapping: UnitMapping, *, scene: Scene
                              for name, value in coords.items()})
     out.attrs.update(mapping.to_attributes())
     out.attrs["resolution"] = json.dumps(asdict(resolution))
+    settings = {name: value for name, value in asdict(spec).items()
+                if name in ("shape", "radius", "polydispersity", "size_ratio", "min_gap")}
+    if spec.present and mapping.length_scale is not None:
+        settings["physical_radius"] = spec.radius * mapping.length_scale
+    out.attrs["inclusions"] = json.dumps(settings) if spec.present else ""
+    out.attrs["inclusion_shape"] = spec.shape if spec.present else "none"
     out.attrs["matrix_fit"] = json.dumps({"law": fit["law"], "params": fit["params"],
                                           "source": fit.get("source")}, ensure_ascii=False)
-    out.attrs["title"] = (f"suspsim study run: {fit['law']} matrix, phi = {volume_fraction:g}, "
-                          f"shear rate {mapping.shear_rate:g} 1/s, seed {seed}")
+    bodies = f" ({spec.shape}s of radius {spec.radius:g} h)" if spec.present else ""
+    out.attrs["title"] = (f"suspsim study run: {fit['law']} matrix, phi = {volume_fraction:g}"
+                          f"{bodies}, shear rate {mapping.shear_rate:g} 1/s, seed {seed}")
     return out
 
 
