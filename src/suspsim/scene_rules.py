@@ -2,9 +2,9 @@
 
 :func:`resolve` takes a scene that passed the schema (defaults filled) and returns it complete:
 run length rules checked, ``run.start``, ``run.output_interval``, ``run.transient`` and
-``run.profile_bins``, ``run.max_density_error``, ``numerics.shifting``, ``numerics.shifting_rate``
-and ``numerics.pressure_reference`` resolved, numbers as floats. ``run.dt``, ``run.sound_speed`` ("auto") and
-``run.threads`` ("all") stay for the solver. Problems go to ``fail(key_path, problem)``, which
+``run.profile_bins``, ``run.max_density_error``, ``numerics.shifting``,
+``numerics.shifting_rate`` and ``numerics.pressure_reference`` resolved, numbers as floats.
+``run.dt``, ``run.sound_speed`` ("auto") and ``run.threads`` ("all") stay for the solver. Problems go to ``fail(key_path, problem)``, which
 raises. Units as in :mod:`suspsim.scene`.
 """
 from __future__ import annotations

@@ -13,7 +13,8 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
     ``datasets``: outputs of :func:`suspsim.validation.squeeze.squeeze_study` (a Dataset or a
     sequence). Top: F/(6πμaU) measured (markers) and the theory with the nominal radius a, which
     the Einstein coefficient calibrates (line; dashed: the drag's hydrodynamic radius a_h).
-    Bottom: F_SPH/F_theory(a) with the ``threshold`` line and each run's cutoff gap s_c marked. ``labels``: legend entries (default: a, a_h/a, U).
+    Bottom: F_SPH/F_theory(a) with the ``threshold`` line and each run's cutoff gap s_c marked.
+    ``labels``: legend entries (default: a, a_h/a, U).
     """
     if isinstance(datasets, xr.Dataset):
         datasets = [datasets]

@@ -377,8 +377,8 @@ class Simulation:
             if self._shifting > 0.0:
                 tb = self._table
                 shift_particles(self._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
-                                self._volume, self._body_of, self._shifting, self._shifting_rate, dt,
-                                SUPPORT, self._gradient, self._grad_c, self._scratch_15,
+                                self._volume, self._body_of, self._shifting,
+                                self._shifting_rate, dt, SUPPORT, self._gradient, self._grad_c, self._scratch_15,
                                 self._bounds, self._x, self._v)
             if self._mean_reference:
                 self._rho_eq = self._fluid_mean_density()

@@ -44,9 +44,9 @@ Comparison: theory evaluated with the hydrodynamic radius a_h (gap s_h = r − 2
 the nominal a; the reported gap is the nominal s = r − 2a. The recommended cutoff s_c is the
 largest gap below which F_SPH/F_theory(a) stays under 0.9 (:func:`cutoff_gap`), with the
 nominal radius: the Einstein coefficient calibrates it (SPEC §3.1: [η] = 2.75 at a = 2.5 h gives
-a_h/a = (2.75/2.5)^(1/3) = 1.03, ``tests/validation/test_suspension.py``), while the single-sphere drag settles
-slowly and scatters by about 15 % over a run (a_h/a from it: 1.06–1.16 at a = 2.5 h, 1.035 at
-4 h), so it is reported beside the comparison but not used.
+a_h/a = (2.75/2.5)^(1/3) = 1.03, ``tests/validation/test_suspension.py``). The single-sphere
+drag agrees (a_h/a = 1.033 at a = 2.5 h, 1.017 at 4 h) but settles slowly and scatters by about
+15 % over a run, so it is reported beside the comparison, not used.
 
 Units: simulation units, lengths [h], mass [m] (particle mass 1), time [τ]; forces
 [m h τ⁻²], viscosity [m h⁻¹ τ⁻¹]. Symbols: a nominal and a_h hydrodynamic radius; r centre
