@@ -96,7 +96,8 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 #: Scenes of ``suspsim bench`` (defined in :mod:`suspsim.sph.bench`).
-BENCH_SCENES = ("fluid-newtonian", "fluid-papanastasiou", "suspension-newtonian")
+BENCH_SCENES = ("fluid-newtonian", "fluid-papanastasiou", "suspension-newtonian",
+                "suspension-papanastasiou")
 _BENCH_COLUMNS = (("scene", "scene", "{}"), ("particles", "n_particles", "{}"),
                   ("threads", "threads", "{}"), ("steps", "steps", "{}"),
                   ("wall s", "wall_time_s", "{:.3g}"),

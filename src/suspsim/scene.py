@@ -109,6 +109,7 @@ class NumericsSpec:
     wi_target: float
     shifting: float
     shifting_rate: float
+    rate_smoothing: bool
     pressure_reference: str
     dt_viscous_coefficient: float
 

@@ -94,9 +94,9 @@ def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
                         types.SimpleNamespace(benchmark=benchmark))
     assert main(["-q", "bench", "--steps", "10"]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert len(table) == 4 and "particle-steps/s" in table[0] and "8.19e+04" in table[1]
+    assert len(table) == 5 and "particle-steps/s" in table[0] and "8.19e+04" in table[1]
     assert [c[0] for c in calls] == ["fluid-newtonian", "fluid-papanastasiou",
-                                     "suspension-newtonian"]
+                                     "suspension-newtonian", "suspension-papanastasiou"]
     assert calls[0][2] == numba.config.NUMBA_NUM_THREADS
     assert main(["-q", "bench", "--scene", "fluid-papanastasiou", "--threads", "1", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]

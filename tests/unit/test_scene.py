@@ -223,9 +223,15 @@ def test_fluid_mean_pressure_reference_needs_shifting(tmp_path):
         load_scene(_write(tmp_path, MINIMAL + "numerics: {pressure_reference: fluid_mean}\n"))
 
 
-def test_shifting_auto_is_on_only_with_inclusions(tmp_path):
-    fluid = load_scene(_write(tmp_path, MINIMAL))
-    suspension = load_scene(_write(tmp_path, MINIMAL + "inclusions: {phi: 0.1, radius: 2.0}\n"))
+@pytest.mark.parametrize("newtonian, expected", [(True, 30.0), (False, 3.0)])
+def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected):
+    text = MINIMAL
+    if newtonian:
+        text = text.replace("law: papanastasiou", "law: newtonian").replace(
+            "{mu_pl: 1.0, mu_0: 99.0, M: 100.0}", "{mu: 1.0}")
+    fluid = load_scene(_write(tmp_path, text))
+    suspension = load_scene(_write(tmp_path, text + "inclusions: {phi: 0.1, radius: 2.0}\n"))
     assert (fluid.numerics.shifting, fluid.numerics.pressure_reference) == (0.0, "nominal")
-    assert suspension.numerics.shifting == 30.0
+    assert suspension.numerics.shifting == expected
     assert suspension.numerics.pressure_reference == "fluid_mean"
+    assert suspension.numerics.rate_smoothing is not newtonian

@@ -8,7 +8,9 @@ default numerics (bulk correction and dissipation normalisation on). Scenes:
 - ``fluid-papanastasiou``: μ_pl = 0.01, μ_0 = 0.99, M = 100 (seed 000: μ_0/μ_pl = 99), γ̇ = 0.01;
 - ``suspension-newtonian``: the Newtonian fluid with spheres of radius 2.5 h at φ = 0.4 (the
   bodies' shell particles count as particles; the start's relaxation is cut to 100 steps, a
-  benchmark measures cost, not physics).
+  benchmark measures cost, not physics);
+- ``suspension-papanastasiou``: the Papanastasiou fluid with the same spheres (adds the
+  shear-rate pass and its smoothing, ``terms.rate_smoothing``).
 
 :func:`benchmark` times ``n_steps`` steps after :data:`WARM_UP` untimed steps and
 reports particle-steps per second (N × steps / wall time), neighbour-list rebuilds included,
@@ -41,6 +43,9 @@ SCENES = {
                              "params": {"mu_pl": 0.01, "mu_0": 0.99, "M": 100.0}}, 0.01, {}),
     "suspension-newtonian": ({"law": "newtonian", "params": {"mu": 1.0}}, 0.0244,
                              {"phi": 0.4, "radius": 2.5}),
+    "suspension-papanastasiou": ({"law": "papanastasiou",
+                                  "params": {"mu_pl": 0.01, "mu_0": 0.99, "M": 100.0}}, 0.01,
+                                 {"phi": 0.4, "radius": 2.5}),
 }
 
 

@@ -25,6 +25,7 @@ from suspsim.sph.boundaries import lees_edwards_offset
 from suspsim.sph.density import body_particle_density, mass_density, summation_density
 from suspsim.sph.neighbours import needs_rebuild
 from suspsim.sph.terms.force_pass import force_finish, force_sums
+from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
                                              _normalisation_finish)
 
@@ -63,8 +64,8 @@ def kick(velocities, accel, accel_new, dt):
 @njit(**JIT_OPTIONS)
 def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours,
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
-                  law_params, newtonian, velocity_gradient, normalise, alpha, beta, bulk_factor,
-                  bulk_gradient, has_bodies, body_of, rho, volume, pressure, pair_end, pair_j,
+                  law_params, newtonian, velocity_gradient, smooth_rate, normalise, alpha, beta,
+                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure, pair_end, pair_j,
                   geometry, pair_cross, pair_image, gradient, inverse_moment, moment_trace,
                   strain, dissipation, gdot, viscosity, factor,
                   viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6,
@@ -72,7 +73,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
 
     ``velocity_gradient`` runs the gradient pass (needed by a non-Newtonian law or the
-    normalisation); ``normalise`` the normalisation pass (else μ̂ must equal μ on entry);
+    normalisation); ``smooth_rate`` evaluates a non-Newtonian law at the kernel-smoothed rate
+    (``terms.rate_smoothing``); ``normalise`` the normalisation pass (else μ̂ must equal μ on entry);
     ``bulk_gradient`` the ∇a sums (B on and μ varying). ``has_bodies``: the scene has rigid
     bodies, whose particles (``body_of`` (N,) ≥ 0; −1 for fluid) take their density from the
     fluid around them (``density.body_particle_density``) and skip pairs inside their own
@@ -88,9 +90,14 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     if velocity_gradient:
         _gradient_sums(nl_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted,
                        volume, shear_ly, dimension, grad_acc, scratch_15, bounds)
-        _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian, normalise, beta,
-                         gradient, inverse_moment, moment_trace, gdot, viscosity, strain,
-                         dissipation)
+        _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian or smooth_rate,
+                         normalise, beta, gradient, inverse_moment, moment_trace, gdot,
+                         viscosity, strain, dissipation)
+        if smooth_rate and not newtonian:
+            smoothed_rate_viscosity(nl_start, pair_end, pair_j, geometry, kernel, h, volume,
+                                    gradient, body_of, law_code, law_params,
+                                    grad_acc[:RATE_WIDTH * rho.shape[0]], scratch_15, bounds,
+                                    gdot, viscosity)
     if normalise:
         if alpha != 0.0:
             _dissipation_sums(nl_start, pair_end, pair_j, geometry, volume, strain, diss_acc,
@@ -111,7 +118,7 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   positions, velocities, accel, predicted, accel_new, box, nl_start,
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
-                  normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
+                  smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
                   volume, pressure, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
                   inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
                   viscosity_hat, grad_acc, diss_acc,
@@ -134,8 +141,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
         predict(velocities, accel, dt, predicted)
         accelerations(positions, predicted, box, offset, nl_start, nl_image_start,
                       nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate, body_force,
-                      dimension, law_code, law_params, newtonian, velocity_gradient, normalise,
-                      alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
+                      dimension, law_code, law_params, newtonian, velocity_gradient, smooth_rate,
+                      normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
                       volume, pressure, pair_end, pair_j, geometry, pair_cross, pair_image,
                       gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
                       factor, viscosity_hat, grad_acc, diss_acc,

@@ -121,6 +121,7 @@ class Simulation:
         self._shifting_rate = float(scene.numerics.shifting_rate)
         self._shifting = float(scene.numerics.shifting) if self._shifting_rate > 0.0 else 0.0
         self._mean_reference = scene.numerics.pressure_reference == "fluid_mean"
+        self._smooth_rate = bool(scene.numerics.rate_smoothing) and not self._newtonian
         if _state is None:
             self.sound_speed = (float(scene.run.sound_speed) if scene.run.sound_speed is not None
                                 else auto_sound_speed(scene))
@@ -247,7 +248,7 @@ class Simulation:
         return (self._box, nl.start, nl.image_start, nl.neighbours, self._kernel, SUPPORT,
                 self._mass, self._rho_eq, self.sound_speed ** 2, self._rate, self._body_force,
                 s.dimension, self._law.code, self._law.packed, self._newtonian,
-                self._velocity_gradient, self._normalise, self._alpha, self._beta,
+                self._velocity_gradient, self._smooth_rate, self._normalise, self._alpha, self._beta,
                 self._bulk_factor, self._bulk_gradient, self.bodies is not None, self._body_of,
                 self._rho, self._volume,
                 self._pressure, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross,

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from suspsim.sph.kernels import LUCY_2D, LUCY_3D, kernel_f
+from suspsim.sph.terms.force_pass import FORCE_WIDTH, force_sums
 from suspsim.sph.terms.gradient import corrected_gradient, invert_symmetric, shear_rate
 from suspsim.sph.terms.normalisation import (continuum_dissipation, moment_dissipation,
                                              normalisation_factor, pair_dissipation,
@@ -39,6 +40,30 @@ def test_pair_force_is_antisymmetric_and_vanishes_beyond_the_support(bulk):
     assert np.all(far == 0.0)
     beyond = pair_force([0, 0, 0], [0.8, 0.7, 0], [1, 2, 3], [0, 0, 0], 4.1, 3.9, 1.0, 1.0)
     assert np.all(beyond == 0.0)
+
+
+def _two_particle_force(body_of, viscosity):
+    """Force on particle 0 from particle 1 through ``force_sums`` (c = 0: viscous only)."""
+    d = np.array([0.3, 0.2, -0.1])
+    f = kernel_f(LUCY_3D, float(np.linalg.norm(d)), 1.0)
+    velocity = np.array([[0.1, -0.2, 0.05], [0.0, 0.3, 0.0]])
+    acc = np.zeros(2 * FORCE_WIDTH)
+    alpha, beta = viscous_weights(3, True)
+    force_sums(np.array([0, 1, 1]), np.array([1, 1]), np.array([1]), np.array([[*d, f]]),
+               np.array([1, 1]), np.zeros(1, dtype=np.int64), velocity, np.full(2, 4.0),
+               np.full(2, 0.25), np.asarray(viscosity, dtype=float), 1.0, 4.0, 0.0, alpha,
+               beta, -5.0 / 3.0, False, 0.0, np.asarray(body_of), np.zeros(2), acc,
+               np.zeros((0, 2 * FORCE_WIDTH)), np.zeros(2, dtype=np.int64), np.zeros((1, 5)))
+    return acc[:3]
+
+
+def test_a_fluid_body_pair_takes_the_fluid_viscosity_at_both_ends():
+    """A body particle's own μ̂ does not enter a fluid–body pair (``force_pass``): the force
+    equals that of two fluid particles of the fluid's μ̂, whichever end is the body."""
+    fluid_pair = _two_particle_force([-1, -1], [1.5, 1.5])
+    np.testing.assert_allclose(_two_particle_force([-1, 0], [1.5, 9.0]), fluid_pair, rtol=1e-14)
+    np.testing.assert_allclose(_two_particle_force([0, -1], [9.0, 1.5]), fluid_pair, rtol=1e-14)
+    assert not np.allclose(_two_particle_force([-1, -1], [1.5, 9.0]), fluid_pair)
 
 
 def test_viscous_weights_combine_a_and_b_as_derived():

@@ -8,6 +8,9 @@ Lees–Edwards correction v_x −= n γ̇ L_y):
          − (μ̂_i + μ̂_j) m² F/(ρ_i ρ_j) [α (r·v) r/r² + β v]      (``viscous``, SPEC §2.3–2.4)
 
 with m² F/(ρ_i ρ_j) = F V_i V_j from the step's volumes V = m/ρ, added to i and subtracted from j (antisymmetric: momentum conserved to round-off).
+A fluid–body pair takes the fluid particle's μ̂ at both ends: a body particle has no viscosity
+of its own, and the rate of its one-sided neighbourhood is meaningless (in a power-law matrix,
+n = 0.5, its μ̂ read 2 × the fluid's, which stiffened every fluid–body pair by a third).
 Pairs of two particles of one rigid body (``body_of[i] == body_of[j] ≥ 0``) are skipped: their
 forces are internal to the body, and the β term of a rotating body would give a spurious torque. With the
 bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
@@ -72,7 +75,13 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
             vz = vzi - velocity[j, 2]
             vol_j = volume[j]
             kp = pressure_pair(p_i, pressure[j], f)
-            wx, wy, wz = viscous_pair(pair_viscosity(mu_i, viscosity[j]), f * vol_i * vol_j,
+            mu_a, mu_b = mu_i, viscosity[j]
+            if (body_i >= 0) != (body_of[j] >= 0):
+                if body_i >= 0:
+                    mu_a = mu_b
+                else:
+                    mu_b = mu_a
+            wx, wy, wz = viscous_pair(pair_viscosity(mu_a, mu_b), f * vol_i * vol_j,
                                       dx, dy, dz, r2, vx, vy, vz, alpha, beta)
             fx = kp * dx + wx
             fy = kp * dy + wy
