@@ -103,8 +103,8 @@ def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, newt
     (:data:`AUTO_SHIFTING_NON_NEWTONIAN` in a non-Newtonian matrix), 0 without;
     ``shifting_rate`` auto → the imposed shear rate of a couette flow, 0 otherwise (shifting's
     diffusivity is A h² γ_s δt, ``terms.shifting``); ``rate_smoothing`` auto → on where
-    shifting acts on a non-Newtonian fluid (``terms.rate_smoothing``); ``pressure_reference`` auto → fluid_mean
-    where shifting acts (A > 0 and γ_s > 0), nominal elsewhere; an explicit fluid_mean where it
+    shifting acts on a non-Newtonian fluid (``terms.rate_smoothing``); ``pressure_reference``
+    auto → fluid_mean where shifting acts (A > 0 and γ_s > 0), nominal elsewhere; an explicit fluid_mean where it
     does not is refused (particles pair up, SPEC §2.3)."""
     out = dict(numerics)
     if numerics["shifting"] == "auto":

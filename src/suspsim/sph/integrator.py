@@ -65,16 +65,17 @@ def kick(velocities, accel, accel_new, dt):
 def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours,
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, smooth_rate, normalise, alpha, beta,
-                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure, pair_end, pair_j,
-                  geometry, pair_cross, pair_image, gradient, inverse_moment, moment_trace,
-                  strain, dissipation, gdot, viscosity, factor,
-                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6,
-                  bounds, virial, accel_out):
+                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
+                  pair_end, pair_j, geometry, pair_cross, pair_image, gradient, inverse_moment,
+                  moment_trace, strain, dissipation, gdot, viscosity, factor, viscosity_hat,
+                  grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6, bounds, virial,
+                  accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
 
     ``velocity_gradient`` runs the gradient pass (needed by a non-Newtonian law or the
     normalisation); ``smooth_rate`` evaluates a non-Newtonian law at the kernel-smoothed rate
-    (``terms.rate_smoothing``); ``normalise`` the normalisation pass (else μ̂ must equal μ on entry);
+    (``terms.rate_smoothing``); ``normalise`` the normalisation pass (else μ̂ must equal μ on
+    entry);
     ``bulk_gradient`` the ∇a sums (B on and μ varying). ``has_bodies``: the scene has rigid
     bodies, whose particles (``body_of`` (N,) ≥ 0; −1 for fluid) take their density from the
     fluid around them (``density.body_particle_density``) and skip pairs inside their own
@@ -118,11 +119,11 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   positions, velocities, accel, predicted, accel_new, box, nl_start,
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
-                  smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
-                  volume, pressure, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
-                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
-                  viscosity_hat, grad_acc, diss_acc,
-                  force_acc, scratch_1, scratch_15, scratch_6, bounds, virial):
+                  smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies,
+                  body_of, rho, volume, pressure, pair_end, pair_j, geometry, pair_cross,
+                  pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
+                  viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
+                  scratch_15, scratch_6, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, rebuild?).
 
     With rebuild? true the drift of step ``step_count + completed + 1`` has been applied and

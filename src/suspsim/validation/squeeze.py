@@ -89,8 +89,8 @@ CUTOFF_RATIO = 0.9
 SOUND_SPEED = 1.5
 REYNOLDS = 0.05
 #: Shifting of the runs, with the rate U/a in place of a shear rate (``numerics.shifting_rate``)
-#: [choice: the Newtonian inclusions' default A]. Without it the single-sphere drag never settles: the
-#: fluid the sphere pushes through turns disordered and its SPH viscosity rises (L = 15 h,
+#: [choice: the Newtonian inclusions' default A]. Without it the single-sphere drag never
+#: settles: the fluid the sphere pushes through turns disordered and its SPH viscosity rises (L = 15 h,
 #: a = 2.5 h: 1.78 → 2.61 × Stokes over 470 τ, Hasimoto's steady value 1.83; with it, 1.77).
 SHIFTING_COEFFICIENT = AUTO_SHIFTING_WITH_INCLUSIONS
 
