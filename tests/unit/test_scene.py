@@ -234,4 +234,3 @@ def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected)
     assert (fluid.numerics.shifting, fluid.numerics.pressure_reference) == (0.0, "nominal")
     assert suspension.numerics.shifting == expected
     assert suspension.numerics.pressure_reference == "fluid_mean"
-    assert suspension.numerics.rate_smoothing is not newtonian

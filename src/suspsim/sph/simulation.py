@@ -121,7 +121,7 @@ class Simulation:
         self._shifting_rate = float(scene.numerics.shifting_rate)
         self._shifting = float(scene.numerics.shifting) if self._shifting_rate > 0.0 else 0.0
         self._mean_reference = scene.numerics.pressure_reference == "fluid_mean"
-        self._smooth_rate = bool(scene.numerics.rate_smoothing) and not self._newtonian
+        self._smooth_rate = bool(scene.numerics.rate_smoothing)
         if _state is None:
             self.sound_speed = (float(scene.run.sound_speed) if scene.run.sound_speed is not None
                                 else auto_sound_speed(scene))

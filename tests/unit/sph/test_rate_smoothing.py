@@ -18,16 +18,15 @@ def constant(xi):
     return np.ones(len(xi))
 
 
-def smoothed(sim, gradient=None, body_of=None):
+def smoothed(sim):
     """(γ̇, μ) of the smoothed rate over the simulation's last pair table."""
     n = sim.n_particles
     gdot, mu = sim._gdot.copy(), np.zeros(n)
     tb = sim._table
     smoothed_rate_viscosity(sim._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
-                            kernel_code("lucy", 3), 1.0, sim._volume,
-                            sim._gradient if gradient is None else gradient,
-                            sim._body_of if body_of is None else body_of, POWER_LAW.code,
-                            POWER_LAW.packed, np.zeros(RATE_WIDTH * n), np.zeros((0, 15 * n)),
+                            kernel_code("lucy", 3), 1.0, sim._volume, sim._gradient,
+                            sim._body_of, POWER_LAW.code, POWER_LAW.packed,
+                            np.zeros(RATE_WIDTH * n), np.zeros((0, 15 * n)),
                             np.zeros(2, dtype=np.int64), gdot, mu)
     return gdot, mu
 
