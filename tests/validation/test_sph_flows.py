@@ -24,10 +24,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "unit" / "sph"))
 from sph_helpers import couette_scene, measured_viscosity_ratio  # noqa: E402
 
 from suspsim.reference.poiseuille import (force_density_for_bingham,  # noqa: E402
-                                          poiseuille_profile, split_force_poiseuille_profile)
+                                          poiseuille_profile)
 from suspsim.rheology.laws import make_law  # noqa: E402
 from suspsim.scene import scene_from_dict  # noqa: E402
 from suspsim.sph.simulation import Simulation  # noqa: E402
+from suspsim.validation.flows import (poiseuille_profile_error,  # noqa: E402
+                                      start_from_newtonian_profile)
 from suspsim.validation.startup import papanastasiou_startup, profile_error  # noqa: E402
 
 pytestmark = pytest.mark.slow
@@ -90,13 +92,12 @@ def test_papanastasiou_startup_matches_the_1d_reference():
 
 def poiseuille_error(law, params, g, dim, density, height, t_run, t_avg, *, lateral=None,
                      newtonian_start=False):
-    """L2 error relative to the peak of the time-averaged profile against SPEC §6.2, one bin
-    per lattice row (bins misaligned with the rows alias the layering into the profile).
-    ``lateral`` box side along x (and z) [h]; default 5 in 3D, 8 in 2D. ``newtonian_start``:
-    start from the Newtonian profile with the reference's flow rate instead of rest (the shape
-    then settles in the yielded layers' diffusion time, not the flow rate in the whole
-    channel's)."""
-    bins = round(height * density ** (1 / dim))
+    """L2 error relative to the peak of the profile averaged over the last ``t_avg`` of
+    ``t_run`` against SPEC §6.2 (``validation.flows.poiseuille_profile_error``: one bin per
+    lattice row). ``lateral`` box side along x (and z) [h]; default 5 in 3D, 8 in 2D.
+    ``newtonian_start``: start from the Newtonian profile with the reference's flow rate
+    instead of rest (the shape then settles in the yielded layers' diffusion time, not the
+    flow rate in the whole channel's)."""
     lateral = lateral or (5.0 if dim == 3 else 8.0)
     box = [lateral, height, lateral] if dim == 3 else [lateral, height]
     scene = scene_from_dict({"dimension": dim, "box": box, "number_density": density,
@@ -105,18 +106,8 @@ def poiseuille_error(law, params, g, dim, density, height, t_run, t_avg, *, late
                              "run": {"time": t_run}, "lattice": {"jitter": 0.1}})
     sim = Simulation(scene, threads=THREADS)
     if newtonian_start:
-        sim = start_from_newtonian_profile(sim, scene, scene.density * g, height)
-    sim.advance(int((t_run - t_avg) / sim.dt))
-    stride = max(1, int(t_avg / sim.dt) // 40)
-    mean = 0.0
-    for _ in range(40):
-        sim.advance(stride)
-        profile = sim.profiles(bins)
-        mean = mean + profile["velocity_profile"] / 40
-    ok, message = sim.health()
-    assert ok, message
-    ref = split_force_poiseuille_profile(scene.fluid.law, scene.density * g, height, profile["y"])
-    return np.sqrt(np.mean((mean - ref) ** 2)) / np.max(np.abs(ref))
+        sim = start_from_newtonian_profile(sim)
+    return poiseuille_profile_error(sim, run_time=t_run, averaging=t_avg).value
 
 
 @pytest.mark.parametrize("dim, density", [(3, DENSITY_3D), (2, DENSITY_2D_POISEUILLE)])
@@ -129,21 +120,6 @@ def test_newtonian_poiseuille_profile(dim, density):
     error = poiseuille_error("newtonian", {"mu": mu}, g, dim, density, height, 3 * t_visc,
                              t_visc)
     assert error < 0.03
-
-
-def start_from_newtonian_profile(sim, scene, force_density, height):
-    """``sim`` restarted with u_x = the split-force Newtonian profile scaled to the flow rate
-    of the scene's law (SPEC §6.2), through the public state/from_state round trip."""
-    fine = np.linspace(0.0, height, 4001)
-    law = scene.fluid.law
-    newtonian = make_law("newtonian", {"mu": float(law.viscosity(1.0))})
-    scale = (np.mean(np.abs(split_force_poiseuille_profile(law, force_density, height, fine)))
-             / np.mean(np.abs(split_force_poiseuille_profile(newtonian, force_density, height,
-                                                             fine))))
-    state = sim.state()
-    state["velocities"][:, 0] = scale * split_force_poiseuille_profile(
-        newtonian, force_density, height, state["positions"][:, 1])
-    return Simulation.from_state(scene, state, threads=THREADS)
 
 
 def bingham_law(density):

@@ -1,0 +1,110 @@
+"""Errors of SPH fluid runs against exact flows (SPEC §6.1, §6.2), shared by the validation
+tests and the speed-against-error study (:mod:`suspsim.convergence`).
+
+- Couette (SPEC §6.1): the measured viscosity σ_xy/γ̇ against the law's μ(γ̇). The stress is
+  averaged over whole strain units after a transient, since a sheared lattice makes it
+  oscillate with period one strain unit; the standard error is that of the strain-unit means.
+- Poiseuille (SPEC §6.2, split force): the time-averaged velocity profile, one bin per lattice
+  row (bins misaligned with the rows alias the layering into the profile), against the
+  reference solution; the error is the L2 norm of the difference over the bins divided by the
+  reference's peak |u|. Rows sliding past each other make the flow rate oscillate with period
+  about spacing/u_max, so the average spans many samples of the last ``averaging`` time.
+
+Symbols: σ_xy shear stress [m h^(2−d) τ^-2]; γ̇ shear rate [τ^-1]; μ viscosity
+[m h^(2−d) τ^-1]; u_x velocity [h τ^-1]; g body-force acceleration [h τ^-2]; ρ mass density
+[m h^-d]; L_y box height [h].
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from suspsim.errors import NumericalError
+from suspsim.reference.poiseuille import split_force_poiseuille_profile
+from suspsim.rheology.laws import make_law
+
+#: Stress samples per strain unit in a Couette reading [choice: resolves the lattice ripple].
+SAMPLES_PER_UNIT = 50
+#: Profile samples over the averaging window of a Poiseuille reading [choice].
+PROFILE_SAMPLES = 40
+
+
+@dataclass(frozen=True)
+class Reading:
+    """A measured error: ``value`` [1] (signed for Couette, an L2 norm for Poiseuille) and its
+    statistical standard error ``stderr`` [1] (NaN where none is estimated)."""
+
+    value: float
+    stderr: float
+
+
+def _require_health(sim) -> None:
+    ok, message = sim.health()
+    if not ok:
+        raise NumericalError(message)
+
+
+def couette_viscosity_ratio(sim, *, transient: float = 1.0, units: int = 3) -> Reading:
+    """σ_xy/(μ(γ̇) γ̇) − 1 of a Couette ``sim`` (a fresh
+    :class:`~suspsim.sph.simulation.Simulation`) averaged over ``units`` whole strain units after ``transient`` strain units; ``stderr`` is
+    the standard deviation of the strain-unit means over √units. Raises NumericalError if the
+    run left its health limits."""
+    scene = sim.scene
+    rate = scene.flow.shear_rate
+    per_unit = max(1, int(round(1.0 / (rate * sim.dt))))
+    sim.advance(int(round(transient * per_unit)))
+    stride = max(1, per_unit // SAMPLES_PER_UNIT)
+    per_block = per_unit // stride
+    stresses = np.empty(units * per_block)
+    for k in range(stresses.size):
+        sim.advance(stride)
+        stresses[k] = sim.sample()["shear_stress"]
+    _require_health(sim)
+    expected = float(scene.fluid.law.viscosity(rate)) * rate
+    blocks = stresses.reshape(units, per_block).mean(axis=1) / expected
+    stderr = float(blocks.std(ddof=1) / np.sqrt(units)) if units > 1 else float("nan")
+    return Reading(float(blocks.mean()) - 1.0, stderr)
+
+
+def poiseuille_profile_error(sim, *, run_time: float, averaging: float) -> Reading:
+    """L2/peak error of the profile of a split-force Poiseuille ``sim`` averaged over the last
+    ``averaging`` [τ] of ``run_time`` [τ] (counted from the simulation's current time), one bin
+    per lattice row, against SPEC §6.2. Raises NumericalError if the run left its limits."""
+    scene = sim.scene
+    height = scene.box[1]
+    bins = int(round(height * scene.number_density ** (1.0 / scene.dimension)))
+    sim.advance(int((run_time - averaging) / sim.dt))
+    stride = max(1, int(averaging / sim.dt) // PROFILE_SAMPLES)
+    mean = np.zeros(bins)
+    for _ in range(PROFILE_SAMPLES):
+        sim.advance(stride)
+        profile = sim.profiles(bins)
+        mean += profile["velocity_profile"] / PROFILE_SAMPLES
+    _require_health(sim)
+    ref = split_force_poiseuille_profile(scene.fluid.law, scene.density * scene.flow.body_force,
+                                         height, profile["y"])
+    return Reading(float(np.sqrt(np.mean((mean - ref) ** 2)) / np.max(np.abs(ref))),
+                   float("nan"))
+
+
+def start_from_newtonian_profile(sim, *, threads: int | None = None):
+    """A new simulation of ``sim``'s Poiseuille scene restarted with u_x = the split-force
+    Newtonian profile scaled to the flow rate of the scene's law (SPEC §6.2), through the
+    public state/from_state round trip: the shape then settles in the yielded layers'
+    diffusion time instead of the whole channel's flow-rate time."""
+    from suspsim.sph.simulation import Simulation
+
+    scene = sim.scene
+    height = scene.box[1]
+    force_density = scene.density * scene.flow.body_force
+    fine = np.linspace(0.0, height, 4001)
+    law = scene.fluid.law
+    newtonian = make_law("newtonian", {"mu": float(law.viscosity(1.0))})
+    scale = (np.mean(np.abs(split_force_poiseuille_profile(law, force_density, height, fine)))
+             / np.mean(np.abs(split_force_poiseuille_profile(newtonian, force_density, height,
+                                                             fine))))
+    state = sim.state()
+    state["velocities"][:, 0] = scale * split_force_poiseuille_profile(
+        newtonian, force_density, height, state["positions"][:, 1])
+    return Simulation.from_state(scene, state, threads=threads or sim.threads)
