@@ -17,8 +17,9 @@ from .rheology.laws import LAW_SPECS, ConstitutiveLaw, make_law
 
 Fail = Callable[[tuple, str], NoReturn]
 
-#: Smallest box side [h]: three kernel supports, so no particle meets its own periodic image.
-MIN_BOX_SIDE = 3.0
+#: Smallest box side [h]: three cells of the neighbour list's cutoff h + skin (0.2 h,
+#: ``sph.simulation.SKIN``), which also keeps every particle from meeting its own periodic image.
+MIN_BOX_SIDE = 3.6
 #: Largest relative gap between the initial lattice's density and number_density [choice].
 LATTICE_DENSITY_TOLERANCE = 0.01
 #: Automatic sampling of couette runs: every 0.05 strain, at least 20 samples [choice].
@@ -68,8 +69,9 @@ def _check_box(dim: int, box, fail: Fail) -> None:
                        f"({'x, y, z' if dim == 3 else 'x, y'}), got {len(box)}")
     for i, side in enumerate(box):
         if side < MIN_BOX_SIDE:
-            fail(("box", i), f"box side {side:g} h holds fewer than {MIN_BOX_SIDE:g} kernel "
-                             f"supports; make it at least {MIN_BOX_SIDE:g}")
+            fail(("box", i), f"box side {side:g} h is below {MIN_BOX_SIDE:g} h, three cells "
+                             f"of the neighbour list (h + skin); make it at least "
+                             f"{MIN_BOX_SIDE:g}")
 
 
 def _make_law(fluid: dict, fail: Fail) -> ConstitutiveLaw:

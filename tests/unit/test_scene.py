@@ -122,7 +122,7 @@ BAD = [
                                      "type: poiseuille\n  body_force: 0.1"), "run.strain", 12, "run.time"),
     ("poiseuille without force", _edit("type: couette\n  shear_rate: 0.01\n", "type: poiseuille\n")
      .replace("strain: 10", "time: 10"), "flow.body_force", 10, "> 0"),
-    ("box too small", _edit("[12, 12, 12]", "[12, 2.5, 12]"), "box[1]", 2, "kernel supports"),
+    ("box too small", _edit("[12, 12, 12]", "[12, 3.5, 12]"), "box[1]", 2, "three cells"),
     ("2-D with 3 box entries", _edit("dimension: 3", "dimension: 2"), "box", 2, "2 box lengths"),
     ("law parameter out of range", _edit("M: 100.0", "M: -1"), "fluid.params.M", 7, "outside"),
     ("law parameter missing", _edit("mu_pl: 1.0, ", ""), "fluid.params", 7, "missing parameter mu_pl"),
@@ -234,3 +234,11 @@ def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected)
     assert (fluid.numerics.shifting, fluid.numerics.pressure_reference) == (0.0, "nominal")
     assert suspension.numerics.shifting == expected
     assert suspension.numerics.pressure_reference == "fluid_mean"
+
+
+def test_smallest_box_side_is_three_cells_of_the_neighbour_list():
+    """A scene that passes validation can always build its cell list (3 cells of h + skin)."""
+    from suspsim.scene_rules import MIN_BOX_SIDE
+    from suspsim.sph.simulation import SKIN, SUPPORT
+
+    assert MIN_BOX_SIDE == pytest.approx(3 * (SUPPORT + SKIN))

@@ -22,8 +22,8 @@ Newtonian case; Papanastasiou with seed 000's μ_0/μ_pl = 99, M = 100 τ and Bi
 Bn = μ_0/(M μ_pl γ̇). Error: |σ_xy/(μ(γ̇)γ̇) − 1| over whole strain units after one unit of
 transient (``validation.flows``).
 
-Poiseuille (SPEC §6.2, split force): width W = L_y/2 [h], lateral sides 3.75 h (3D) or 8 h
-(2D). Newtonian: ν = 1.25 h²/τ, u_max = g W²/(8ν) kept at its W = 5 h value (g = 0.01 h τ⁻²
+Poiseuille (SPEC §6.2, split force): width W = L_y/2 [h], lateral sides at least 3.75 h (3D)
+or 8 h (2D), rounded up to whole rows. Newtonian: ν = 1.25 h²/τ, u_max = g W²/(8ν) kept at its W = 5 h value (g = 0.01 h τ⁻²
 there), run 3 t_ν, t_ν = W²/ν, the last t_ν averaged. Bingham (Papanastasiou, μ_0/μ_pl = 99,
 M = 100, ν_pl = 20/4.096 h²/τ): the body force of the Bingham number (``reference.poiseuille``),
 started from the Newtonian profile of equal flow rate, run 0.8 t_pl and the last 0.2 t_pl
@@ -180,8 +180,7 @@ def _channel_axes(dim: int) -> tuple[Axis, ...]:
 def _channel_box(settings, dim: int) -> tuple[list[float], float]:
     height = 2.0 * float(settings["width"])
     q = snapped_resolution(float(settings["resolution"]), height)
-    lateral = (3.75 if dim == 3 else 8.0)
-    lateral = max(3, round(lateral * q)) / q
+    lateral = math.ceil((3.75 if dim == 3 else 8.0) * q) / q
     box = [lateral, height, lateral] if dim == 3 else [lateral, height]
     return box, q ** dim
 
