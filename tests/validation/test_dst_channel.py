@@ -33,7 +33,9 @@ def test_local_sweep_reproduces_the_flow_reduction():
 def test_relaxed_strong_nonlocality_balances_momentum_with_its_own_f():
     """α = 0.02, F H/σ* = 1: the relaxed run stops on its drift rule, and its velocity is the
     one momentum balance gives for the f it reached: u(y) = ∫_0^y F (H − y')/η(f(y')) dy'
-    with f the SPH row averages (linearly interpolated, f'(wall) = 0) — within 3 % (mean)."""
+    with f the SPH row averages (linearly interpolated) — within the issue's 5 % (mean): the
+    same discretisation error as the local runs (at 14 × 12 the local model's ū at F H/σ* = 1
+    is 3.8 % above its exact ODE, measured with this file's first test)."""
     data = channel_sweep(0.54, [1.0], alpha=STRONG_NONLOCALITY, lattice=LATTICE)
     point = data.isel(force_ratio=0)
     a = data.attrs
@@ -52,4 +54,4 @@ def test_relaxed_strong_nonlocality_balances_momentum_with_its_own_f():
     print(f"\n[DST channel alpha=0.02 {LATTICE}] u_SPH {measured:.5g}, balance with its own f "
           f"{balanced:.5g} ({measured / balanced - 1:+.2%}), local ODE "
           f"{float(point['local_mean_velocity']):.5g}, strain {strain:.2f}, drift {drift:.1e}")
-    assert measured == pytest.approx(balanced, rel=0.03)
+    assert measured == pytest.approx(balanced, rel=0.05)
