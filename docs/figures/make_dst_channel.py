@@ -132,8 +132,9 @@ def main() -> None:
     total = time.perf_counter() - start
     write_groups(NETCDF, datasets, total)
     _figures(datasets)
-    print(f"\ntotal wall time {total:.0f} s ({sum(d.sizes['force_ratio'] for d in datasets.values())}"
-          f" runs, threads {args.threads}); wrote {NETCDF}, {PROFILES} and {FLOW}")
+    runs = sum(d.sizes["force_ratio"] for d in datasets.values())
+    print(f"\ntotal wall time {total:.0f} s ({runs} runs, threads {args.threads}); wrote "
+          f"{NETCDF}, {PROFILES} and {FLOW}")
 
 
 if __name__ == "__main__":

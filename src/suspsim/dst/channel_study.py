@@ -20,17 +20,18 @@ Two protocols (``protocol``; default ``"momentum"`` for α = 0, ``"relaxed"`` fo
   time units); ``fraction_residual`` = rms(f̂(σ_i) − f_i) measures how far the SPH stress
   leaves f from steady. This is the local model with f at its steady value.
 * ``"relaxed"`` — f must reach its own steady state, which with non-locality differs from
-  f̂(σ): start and run one momentum time as above, then advance in chunks of ``chunk_strain``/(K_f ⟨γ̇⟩) and accumulate
-  the microstructure strain s = K_f ∫⟨γ̇⟩ dt (the uniform part of f − f_steady decays like
-  e^(−s)); stop once s ≥ ``min_strain`` and the mean velocity changed by less than
-  ``tolerance`` (relative) over the last unit of s, or at ``max_strain``. The final change
-  is stored (``mean_velocity_drift``). ρ = 2000 by default: a parallel steady flow does not
-  depend on ρ, which sets only the momentum time ρ L_y²/(π² η(0)) ≈ 10 against the
-  microstructure time 1/(K_f ⟨γ̇⟩) ≈ 60 at F H/σ* = 3 [measured, α = 0.02, 14 × 20: the mean
-  velocity at t = 150 was 0.0054929 at ρ = 2000 and 0.0054963 at ρ = 205 (0.06 %), and the
-  step 10 times longer]. The sound speed is the Morris value for the velocity scale
-  2 max(u_max) of the two reference models (the solver's default bound F H²/(2η(0)) is 30
-  times the real velocity at F H/σ* = 100 and would make the sound step bind).
+  f̂(σ): start and run one momentum time as above, then advance in chunks of
+  ``chunk_strain``/(K_f ⟨γ̇⟩) and accumulate the microstructure strain s = K_f ∫⟨γ̇⟩ dt (the
+  uniform part of f − f_steady decays like e^(−s)); stop once s ≥ ``min_strain`` and the
+  mean velocity changed by less than ``tolerance`` (relative) over the last unit of s, or at
+  ``max_strain``. The final change is stored (``mean_velocity_drift``). ρ = 2000 by
+  default: a parallel steady flow does not depend on ρ, which sets only the momentum time
+  ρ L_y²/(π² η(0)) ≈ 10 against the microstructure time 1/(K_f ⟨γ̇⟩) ≈ 40–60 at
+  F H/σ* = 3 [measured, α = 0.02, 14 × 20: the mean velocity at t = 150 was 0.0054929 at
+  ρ = 2000 and 0.0054963 at ρ = 205 (0.06 %), reached in 8.3 times fewer steps]. The sound
+  speed is the Morris value for the velocity scale 2 max(u_max) of the two reference models
+  (the solver's default bound F H²/(2η(0)) is 30 times the real velocity at F H/σ* = 100
+  and would make the sound step bind).
 """
 from __future__ import annotations
 
