@@ -15,7 +15,8 @@ and a Wyart–Cates microstructure f per particle.
   snapshot, branch statistics, state/restore);
 - :mod:`~suspsim.dst.scene` and :mod:`~suspsim.dst.run`: DST scene files and their
   ``suspsim run`` (the run loop of :mod:`suspsim.run`);
-- :mod:`~suspsim.dst.study`: stress-controlled flow curves.
+- :mod:`~suspsim.dst.study`: stress-controlled flow curves;
+- :mod:`~suspsim.dst.channel_study`: channel flow against driving force (Fig. 7–8).
 """
 from suspsim.dst.parameters import Channel, Geometry, Numerics, StressCouette, WyartCatesFluid
 from suspsim.dst.simulation import DSTSimulation

@@ -7,6 +7,8 @@
 * :mod:`~suspsim.reference.couette_startup` — start-up of Couette flow from rest (the
   Lees–Edwards box of seed 000 Fig. 1): 1D finite volumes for any law, Newtonian series.
 * :mod:`~suspsim.reference.dst_channel` — steady local Wyart–Cates channel flow (SPEC §5.7).
+* :mod:`~suspsim.reference.inverse_biviscous` — inverse-biviscous DST flow curve (rate plateau)
+  and its channel flow, the comparison model of seed 002 Fig. 8.
 """
 from suspsim.reference.couette_startup import couette_startup, newtonian_couette_startup
 from suspsim.reference.poiseuille import (bingham_number, force_density_for_bingham,
