@@ -7,11 +7,13 @@ from typing import Sequence
 import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter
 
 #: Colours of the swept axes (base in black); other axes cycle through the rest.
 _AXIS_COLOURS = {"base": "black", "resolution": "tab:blue", "dt_coefficient": "tab:orange",
                  "wi_target": "tab:green", "kernel": "tab:red", "side": "tab:purple",
-                 "width": "tab:purple", "units": "tab:brown", "transient": "tab:pink"}
+                 "width": "tab:purple", "units": "tab:brown", "transient": "tab:pink",
+                 "jitter": "tab:cyan", "several": "tab:olive"}
 
 
 def _axis_of(configuration: str) -> str:
@@ -53,10 +55,12 @@ def plot_pareto(datasets: Sequence[xr.Dataset], *, columns: int = 3) -> Figure:
         ax.set_title(title + (f" ({failed} blew up)" if failed else ""), fontsize=9)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("CPU time, one thread [s]")
         ax.set_ylabel("error against the reference [1]")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=6, loc="best")
     for ax in axes[n:]:
         ax.set_visible(False)
     return fig
