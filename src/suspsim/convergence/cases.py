@@ -28,10 +28,14 @@ there), run 3 t_ν, t_ν = W²/ν, the last t_ν averaged. Bingham (Papanastasio
 M = 100, ν_pl = 20/4.096 h²/τ): the body force of the Bingham number (``reference.poiseuille``),
 started from the Newtonian profile of equal flow rate, run 0.8 t_pl and the last 0.2 t_pl
 averaged, t_pl = W²/ν_pl. Error: L2/peak of the averaged profile.
+
+DST flow-curve point (SPEC §1.3, §5.4; :class:`DSTPointCase`): the 2D Wyart–Cates solver
+under stress control; error ⟨γ̇⟩/γ̇_WC − 1.
 """
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
@@ -53,6 +57,8 @@ CHANNEL_NU, CHANNEL_FORCE, CHANNEL_WIDTH = 1.25, 0.01, 5.0
 #: Kinematic plastic viscosity of the Bingham channel [h² τ⁻¹] (the validation's μ_pl = 20 at
 #: n = 4.096).
 BINGHAM_NU = 20.0 / 4.096
+#: Steps of the untimed warm-up that loads the compiled code [choice].
+WARM_UP_STEPS = 2
 #: Default lattice jitter [spacings] (a start off the lattice, as the validations).
 JITTER = 0.1
 
@@ -77,18 +83,11 @@ def _common_axes(resolution: float) -> tuple[Axis, ...]:
             Axis("jitter", JITTER, "1", "random displacement of the start lattice [spacings]"))
 
 
-@dataclass(frozen=True)
-class Case:
-    """One validation case: ``scene(settings)`` → scene dict, ``measure(sim, settings)`` →
-    :class:`~suspsim.validation.flows.Reading` of the error on a fresh simulation."""
+class _Settings:
+    """The axes' defaults and their validated overrides (shared by every kind of case)."""
 
     name: str
-    description: str
-    reference: str
     axes: tuple[Axis, ...]
-    scene: Callable[[Mapping[str, Any]], dict]
-    measure: Callable[[Any, Mapping[str, Any]], Reading]
-    restart: Callable[[Any], Any] | None = field(default=None)
 
     def settings(self, overrides: Mapping[str, Any] | None = None) -> dict[str, Any]:
         """The axes' defaults updated by ``overrides``; an unknown axis is an InputError."""
@@ -101,9 +100,65 @@ class Case:
             out[key] = value
         return out
 
+
+@dataclass(frozen=True)
+class Run:
+    """What :meth:`Case.execute` measured: the error ``reading`` and the run's size
+    (particles, steps, time step [τ], sound speed [h τ⁻¹], number density [h⁻ᵈ] and q after
+    snapping; NaN where the solver has none) and its set-up and run wall times [s]."""
+
+    reading: Reading
+    n_particles: int
+    n_steps: int
+    dt: float
+    sound_speed: float
+    number_density: float
+    resolution_used: float
+    setup_time: float
+    run_time: float
+
+
+@dataclass(frozen=True)
+class Case(_Settings):
+    """An SPH fluid case: ``scene(settings)`` → scene dict, ``measure(sim, settings)`` →
+    :class:`~suspsim.validation.flows.Reading` of the error on a fresh simulation
+    (``restart(sim)`` first replaces the start where the case needs one)."""
+
+    name: str
+    description: str
+    reference: str
+    axes: tuple[Axis, ...]
+    scene: Callable[[Mapping[str, Any]], dict]
+    measure: Callable[[Any, Mapping[str, Any]], Reading]
+    restart: Callable[[Any], Any] | None = field(default=None)
+
     def build(self, settings: Mapping[str, Any]) -> Scene:
         """The validated scene of ``settings`` (a full set, see :meth:`settings`)."""
         return scene_from_dict(self.scene(settings), source=f"case {self.name}")
+
+    def warm_up(self, settings: Mapping[str, Any], threads: int) -> None:
+        """Two steps of the same scene (and restart), so compiled code is loaded."""
+        from suspsim.sph.simulation import Simulation
+
+        warm = Simulation(self.build(settings), threads=threads)
+        warm.advance(WARM_UP_STEPS)
+        if self.restart is not None:
+            self.restart(warm).advance(WARM_UP_STEPS)
+
+    def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
+        """Build, (re)start and measure one simulation of ``settings``."""
+        from suspsim.sph.simulation import Simulation
+
+        t0 = time.perf_counter()
+        scene = self.build(settings)
+        sim = Simulation(scene, threads=threads)
+        if self.restart is not None:
+            sim = self.restart(sim)
+        t1 = time.perf_counter()
+        reading = self.measure(sim, settings)
+        return Run(reading, sim.n_particles, sim.step_count, sim.dt, sim.sound_speed,
+                   scene.number_density, scene.number_density ** (1.0 / scene.dimension),
+                   t1 - t0, time.perf_counter() - t1)
 
 
 def snapped_resolution(resolution: float, length: float) -> float:
@@ -235,11 +290,70 @@ def bingham_poiseuille(bingham: float = 1.0, dim: int = 3) -> Case:
                 restart=start_from_newtonian_profile)
 
 
+@dataclass(frozen=True)
+class DSTPointCase(_Settings):
+    """A stress-controlled Wyart–Cates flow-curve point of the 2D DST solver
+    (:func:`suspsim.dst.study.flow_curve`, scaled units η_s = σ* = L_y = 1, seed 002's
+    φ_m, φ_0, β and K_f): error ⟨γ̇⟩/γ̇_WC(σ_in) − 1 against the steady Wyart–Cates curve
+    (SPEC §1.3), with the batch-means standard error of ⟨γ̇⟩. Axes: the lattice (``n_y``
+    particles across the gap, the resolution; ``n_x`` along it), ``epsilon`` (the density
+    ε = K_f γ̇ ρ L_y²/η, which sets Re and the viscous step count) and the equilibration and
+    averaging strains."""
+
+    name: str
+    description: str
+    reference: str
+    axes: tuple[Axis, ...]
+    phi: float
+    stress: float
+    alpha: float
+
+    def _point(self, settings, threads, equilibration, averaging):
+        from suspsim.dst.study import flow_curve
+
+        return flow_curve(self.phi, [self.stress], alpha=self.alpha,
+                          lattice=(int(settings["n_x"]), int(settings["n_y"])), threads=threads,
+                          epsilon=float(settings["epsilon"]), equilibration_strain=equilibration,
+                          averaging_strain=averaging).isel(stress=0)
+
+    def warm_up(self, settings: Mapping[str, Any], threads: int) -> None:
+        """A run of 0.02 strain on the same lattice, so compiled code is loaded."""
+        self._point(settings, threads, 0.01, 0.01)
+
+    def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
+        t0 = time.perf_counter()
+        point = self._point(settings, threads, float(settings["equilibration_strain"]),
+                            float(settings["averaging_strain"]))
+        rate = float(point["wyart_cates_shear_rate"])
+        reading = Reading(float(point["shear_rate"]) / rate - 1.0,
+                          float(point["shear_rate_stderr"]) / rate)
+        n_y = int(settings["n_y"])
+        return Run(reading, int(point.attrs["n_particles"]), int(point["steps"]),
+                   float(point["time_step"]), float(point["sound_speed"]), float("nan"),
+                   float(n_y), 0.0, time.perf_counter() - t0)
+
+
+def dst_flow_curve_point(phi: float = 0.54, stress: float = 2.5,
+                         alpha: float = 0.02) -> DSTPointCase:
+    """φ = 0.54 at σ_in = 2.5 σ* lies on the unstable branch (σ_β = 0.76, σ_α = 3.92);
+    α = 0.02 is seed 002's strong non-locality scaled."""
+    axes = (Axis("n_y", 20, "1", "fluid particles across the gap (the resolution)"),
+            Axis("n_x", 14, "1", "fluid particles along the periodic direction"),
+            Axis("epsilon", 0.1, "1", "K_f gdot rho L_y^2/eta, which sets the density"),
+            Axis("equilibration_strain", 1.5, "1", "strain gdot_WC t discarded"),
+            Axis("averaging_strain", 1.5, "1", "strain gdot_WC t averaged"))
+    return DSTPointCase(f"dst_point_phi{phi:g}_sigma{stress:g}_alpha{alpha:g}",
+                        f"DST flow-curve point (2D), phi = {phi:g}, sigma = {stress:g} sigma*, "
+                        f"alpha = {alpha:g}", "steady Wyart-Cates curve (SPEC 1.3)", axes,
+                        phi, stress, alpha)
+
+
 #: The registered cases by name.
 CASES: dict[str, Case] = {case.name: case for case in (
     newtonian_couette(3), newtonian_couette(2), papanastasiou_couette(9.9, 3),
     papanastasiou_couette(99.0, 3), newtonian_poiseuille(3), newtonian_poiseuille(2),
-    bingham_poiseuille(1.0, 3), bingham_poiseuille(10.0, 3))}
+    bingham_poiseuille(1.0, 3), bingham_poiseuille(10.0, 3), dst_flow_curve_point(0.54, 2.5),
+    dst_flow_curve_point(0.50, 1.0))}
 
 
 def get_case(name: str) -> Case:

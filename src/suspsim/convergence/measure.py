@@ -13,50 +13,34 @@ import logging
 import time
 from typing import Any, Mapping
 
-from suspsim.convergence.cases import Case
-from suspsim.sph.simulation import Simulation
 
 log = logging.getLogger(__name__)
 
-#: Steps of the untimed warm-up that loads the compiled code [choice].
-WARM_UP_STEPS = 2
-
-
-def run_configuration(case: Case, overrides: Mapping[str, Any] | None = None, *,
+def run_configuration(case, overrides: Mapping[str, Any] | None = None, *,
                       threads: int = 1) -> dict[str, Any]:
-    """Measure ``case`` at its defaults updated by ``overrides`` on ``threads`` threads.
+    """Measure ``case`` (:mod:`.cases`) at its defaults updated by ``overrides`` on
+    ``threads`` threads, after its warm-up.
 
-    Returns the full settings and: ``error`` |e| [1], ``signed_error`` e [1] (the Couette
-    viscosity ratio − 1; the L2/peak norm for profiles), ``error_stderr`` [1] (NaN where not
-    estimated), ``wall_time`` and ``cpu_time`` [s] (set-up + run), ``setup_time`` [s],
-    ``n_particles``, ``n_steps``, ``particle_steps_per_s`` [s-1], ``dt`` [τ], ``sound_speed`` [h τ⁻¹],
-    ``number_density`` [h⁻ᵈ] and ``resolution_used`` (q after snapping) [1]. A run that leaves
-    its health limits raises :class:`~suspsim.errors.NumericalError`.
+    Returns the full settings and: ``error`` |e| [1], ``signed_error`` e [1] (a ratio − 1, or
+    the L2/peak norm for profiles), ``error_stderr`` [1] (NaN where not estimated),
+    ``wall_time`` and ``cpu_time`` [s] (set-up + run), ``setup_time`` [s], ``n_particles``,
+    ``n_steps``, ``particle_steps_per_s`` [s-1], ``dt``, ``sound_speed``, ``number_density``
+    and ``resolution_used`` (:class:`~.cases.Run`). A run that leaves its health limits raises
+    :class:`~suspsim.errors.NumericalError`.
     """
     settings = case.settings(overrides)
-    scene = case.build(settings)
-    warm = Simulation(scene, threads=threads)
-    warm.advance(WARM_UP_STEPS)
-    if case.restart is not None:
-        case.restart(warm).advance(WARM_UP_STEPS)
-    del warm
+    case.warm_up(settings, threads)
     t0, c0 = time.perf_counter(), time.process_time()
-    sim = Simulation(scene, threads=threads)
-    if case.restart is not None:
-        sim = case.restart(sim)
-    t1 = time.perf_counter()
-    reading = case.measure(sim, settings)
-    t2, c2 = time.perf_counter(), time.process_time()
-    n_steps = sim.step_count
+    run = case.execute(settings, threads)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    reading = run.reading
     record = dict(settings)
     record.update(
         error=abs(reading.value), signed_error=reading.value, error_stderr=reading.stderr,
-        wall_time=t2 - t0, cpu_time=c2 - c0, setup_time=t1 - t0, n_particles=sim.n_particles,
-        n_steps=n_steps,
-        particle_steps_per_s=sim.n_particles * n_steps / (t2 - t1), dt=sim.dt,
-        sound_speed=sim.sound_speed, number_density=scene.number_density,
-        resolution_used=scene.number_density ** (1.0 / scene.dimension), threads=threads)
+        wall_time=wall, cpu_time=cpu, setup_time=run.setup_time, n_particles=run.n_particles,
+        n_steps=run.n_steps, particle_steps_per_s=run.n_particles * run.n_steps / run.run_time,
+        dt=run.dt, sound_speed=run.sound_speed, number_density=run.number_density,
+        resolution_used=run.resolution_used, threads=threads)
     log.info("%s %s: error %.3g in %.1f s (%d particles, %d steps)", case.name,
-             dict(overrides or {}), record["error"], record["wall_time"], sim.n_particles,
-             n_steps)
+             dict(overrides or {}), record["error"], wall, run.n_particles, run.n_steps)
     return record
