@@ -343,8 +343,8 @@ def dst_flow_curve_point(phi: float = 0.54, stress: float = 2.5,
             Axis("equilibration_strain", 1.5, "1", "strain gdot_WC t discarded"),
             Axis("averaging_strain", 1.5, "1", "strain gdot_WC t averaged"))
     return DSTPointCase(f"dst_point_phi{phi:g}_sigma{stress:g}_alpha{alpha:g}",
-                        f"DST flow-curve point (2D), phi = {phi:g}, sigma = {stress:g} sigma*, "
-                        f"alpha = {alpha:g}", "steady Wyart-Cates curve (SPEC 1.3)", axes,
+                        f"DST point (2D), phi = {phi:g}, sigma = {stress:g}, alpha = {alpha:g}",
+                        "steady Wyart-Cates curve (SPEC 1.3)", axes,
                         phi, stress, alpha)
 
 
