@@ -164,7 +164,18 @@ def run_seed(wildcards):
     return int(wildcards.seed)
 
 
+#: Functions returning the final outputs of the optional studies (dst, ...); each stage file of
+#: such a study appends its own, so rule all asks for them without knowing the study.
+STUDY_OUTPUTS = []
+
+
 def all_outputs():
+    """The material pipeline's final files (when material_study) and every optional study's."""
     names = ("fit.json", "fit.png", "homogenisation.nc", "homogenisation.png", "summary.nc",
              "summary.png")
-    return [str(RESULTS / m / name) for m in MATERIALS for name in names]
+    outputs = []
+    if config["material_study"]:
+        outputs += [str(RESULTS / m / name) for m in MATERIALS for name in names]
+    for study_outputs in STUDY_OUTPUTS:
+        outputs += study_outputs()
+    return outputs
