@@ -16,6 +16,7 @@ include: "workflow/rules/predict.smk"
 include: "workflow/rules/pack.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/gather.smk"
+include: "workflow/rules/dst.smk"
 
 
 rule all:
