@@ -16,12 +16,12 @@ import pytest
 import xarray as xr
 import yaml
 
-from suspsim.stages.dst import study_points
+from suspsim.stages.dst import band_points, study_points
 
 REPO = Path(__file__).resolve().parents[2]
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 REDUCED = os.environ.get("SUSPSIM_REDUCED") == "1"
-DST_RULES = {"simulate_dst_point", "gather_dst", "plot_dst"}
+DST_RULES = {"simulate_dst_point", "simulate_dst_band", "gather_dst", "plot_dst"}
 
 
 def _study(tmp_path):
@@ -77,8 +77,12 @@ def test_dst_study_lists_one_job_per_point_and_nothing_else(tmp_path):
     settings = _settings(study, "dst")
     points = study_points(settings)
     assert len(points) == 3 * 3 * 12
-    assert _jobs(dry) == {"simulate_dst_point": len(points), "gather_dst": 1, "plot_dst": 1,
-                          "all": 1}
+    bands = band_points(settings)
+    assert [p.nonlocality.name for p in bands] == ["moderate", "zero"]
+    assert _jobs(dry) == {"simulate_dst_point": len(points), "simulate_dst_band": len(bands),
+                          "gather_dst": 1, "plot_dst": 1, "all": 1}
+    assert {(f"{p.phi:g}", p.nonlocality.name, f"{p.index:02d}") for p in bands} == set(
+        _wildcards(dry, "simulate_dst_band"))
     wanted = {(f"{p.phi:g}", p.nonlocality.name, f"{p.index:02d}") for p in points}
     listed = _wildcards(dry, "simulate_dst_point")
     assert len(listed) == len(points) and set(listed) == wanted
@@ -150,6 +154,8 @@ def test_reduced_dst_study_end_to_end_against_the_wyart_cates_curve(tmp_path):
         # on the stable branches nothing splits at any non-locality
         stable = data.sel(phi=0.54).isel(stress_index=np.nonzero((q < 0) | (q > 1))[0])
         assert np.all(stable["frictional_fraction_spread"].values < 0.01)
+        assert list(data["band_nonlocality"].values) == ["moderate"]
+        assert data["band_particle_x"].shape == (1, 13 * 10)
     for name in ("flow_curves", "particles", "splitting", "bands"):
         assert (results / f"{name}.png").stat().st_size > 10_000
     for rule in ("simulate_dst_point/phi-0.54_nonlocality-zero_stress-01", "gather_dst/gather_dst",

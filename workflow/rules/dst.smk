@@ -1,12 +1,13 @@
 # The dst study (seed 002, issue 5): one stress-controlled DST run per volume fraction x
 # non-locality x imposed stress (suspsim.stages.dst), gathered into results/dst/flow_curves.nc,
 # and its figures. A channel rule (Fig. 7, 8) can sit beside these under results/dst/channel/.
-from suspsim.stages.dst import find_point, point_scene, study_points
+from suspsim.stages.dst import band_points, find_point, point_scene, study_points
 
 
 DST = config["dst"]
 DST_DIR = RESULTS / "dst"
 DST_POINTS = study_points(DST)
+DST_BANDS = band_points(DST)
 CODE_DST = {
     "simulate": code_version("suspsim.stages.dst"),
     "gather": code_version("suspsim.stages.dst_gather"),
@@ -14,9 +15,9 @@ CODE_DST = {
 }
 
 
-def _dst_run(point):
-    return (f"{DST_DIR}/runs/phi-{number_tag(point.phi)}_nonlocality-{point.nonlocality.name}"
-            f"_stress-{point.index:02d}.nc")
+def _dst_run(point, folder="runs"):
+    return (f"{DST_DIR}/{folder}/phi-{number_tag(point.phi)}_nonlocality-"
+            f"{point.nonlocality.name}_stress-{point.index:02d}.nc")
 
 
 def dst_run_files(wildcards):
@@ -24,10 +25,21 @@ def dst_run_files(wildcards):
     return [_dst_run(point) for point in DST_POINTS]
 
 
+def dst_band_files(wildcards):
+    """The band runs, in band_points order."""
+    return [_dst_run(point, "bands") for point in DST_BANDS]
+
+
 def dst_scene(wildcards):
     """The DST scene (a dict) of one point: every setting of the run, so a change re-runs it."""
     return point_scene(DST, find_point(DST, float(wildcards.phi), wildcards.nonlocality,
                                        int(wildcards.index)))
+
+
+def dst_band_scene(wildcards):
+    """The DST scene of one band run (the band lattice and run lengths)."""
+    return point_scene(DST, find_point(DST, float(wildcards.phi), wildcards.nonlocality,
+                                       int(wildcards.index), band=True), band=True)
 
 
 def dst_outputs():
@@ -59,9 +71,23 @@ rule simulate_dst_point:
         "../scripts/simulate_dst_point.py"
 
 
+# The band runs: the same job on the band lattice (one point, a few non-localities).
+use rule simulate_dst_point as simulate_dst_band with:
+    output:
+        run=f"{DST_DIR}/bands/phi-{{phi}}_nonlocality-{{nonlocality}}_stress-{{index}}.nc",
+    log:
+        "logs/simulate_dst_band/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.log",
+    benchmark:
+        "logs/benchmarks/simulate_dst_band/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.tsv"
+    params:
+        scene=dst_band_scene,
+        code=CODE_DST["simulate"],
+
+
 rule gather_dst:
     input:
         runs=dst_run_files,
+        bands=dst_band_files,
     output:
         flow_curves=f"{DST_DIR}/flow_curves.nc",
     log:

@@ -207,49 +207,74 @@ def plot_bands(data: xr.Dataset, phi: float, index: int) -> Figure:
     """The f field of the final snapshot per non-locality (seed 002 Fig. 4 g–i) and the band
     criterion against the imposed stress.
 
-    Top row: f(x, y) of the run at ``phi`` and stress index ``index``, one square per particle
-    (x periodic over L_x, walls at y = 0 and 1), each panel with its own colour range, titled
-    with the correlation length ξ in lattice spacings Δx. Bottom: ξ/Δx of every run at ``phi``
-    against σ_in, one line per non-locality, the unstable range σ_β < σ_in < σ_α shaded
+    Top row: f(x, y) at ``phi`` and stress index ``index``, one square per particle (x periodic
+    over L_x, walls at y = 0 and 1), each panel with its own colour range, titled with the
+    correlation length ξ in lattice spacings Δx and the spread of f — from the band runs
+    (``band_*``, their own lattice) when ``data`` has them, else from the study's runs. Bottom:
+    ξ/Δx of every study run at ``phi`` against σ_in, one line per non-locality, the band runs'
+    ξ as stars, the unstable range σ_β < σ_in < σ_α shaded
     (:func:`suspsim.stages.dst_gather.correlation_length`). No file I/O.
     """
-    names = list(data["nonlocality"].values)
     spacing = 1.0 / int(data.attrs["n_y"])
-    fig = Figure(figsize=(4.2 * len(names), 7.4), layout="constrained")
-    grid = fig.add_gridspec(2, len(names), height_ratios=(1.2, 1))
-    point = data.sel(phi=phi).isel(stress_index=index)
-    for k, name in enumerate(names):
+    banded = "band_nonlocality" in data.coords
+    if banded:
+        names = [str(n) for n in data["band_nonlocality"].values]
+        lattice = (data.attrs["band_n_x"], data.attrs["band_n_y"])
+        band_spacing = 1.0 / int(lattice[1])
+        fields = [{key: data[f"band_{key}"].sel(band_nonlocality=name).values
+                   for key in ("particle_x", "particle_y", "particle_frictional_fraction",
+                               "correlation_length", "frictional_fraction_spread")}
+                  for name in names]
+        stress = float(data["band_stress"])
+    else:
+        names = [str(n) for n in data["nonlocality"].values]
+        lattice, band_spacing = (data.attrs["n_x"], data.attrs["n_y"]), spacing
+        point = data.sel(phi=phi).isel(stress_index=index)
+        fields = [{key: point[key].sel(nonlocality=name).values
+                   for key in ("particle_x", "particle_y", "particle_frictional_fraction",
+                               "correlation_length", "frictional_fraction_spread")}
+                  for name in names]
+        stress = float(point["imposed_stress"])
+    fig = Figure(figsize=(max(4.2 * len(names), 9.0), 7.6), layout="constrained")
+    grid = fig.add_gridspec(2, len(names), height_ratios=(1.3, 1))
+    for k, (name, field) in enumerate(zip(names, fields)):
         ax = fig.add_subplot(grid[0, k])
-        run = point.sel(nonlocality=name)
-        f = run["particle_frictional_fraction"].values
-        dots = ax.scatter(run["particle_x"].values, run["particle_y"].values, c=f,
-                          cmap="viridis", marker="s", s=16)
+        dots = ax.scatter(field["particle_x"], field["particle_y"],
+                          c=field["particle_frictional_fraction"], cmap="viridis", marker="s",
+                          s=max(4.0, 2000.0 / field["particle_x"].size))
         fig.colorbar(dots, ax=ax, label="f [1]", shrink=0.8)
         ax.set_aspect("equal")
         ax.set_ylim(0.0, 1.0)
         ax.set_xlabel("x [L_y]")
         ax.set_ylabel("y [L_y]")
-        ax.set_title(f"{name} (α = {float(run['alpha']):g}): ξ = "
-                     f"{float(run['correlation_length']) / spacing:.2f} Δx\n"
-                     f"std f = {float(run['frictional_fraction_spread']):.3f}",
+        alpha = float(data["alpha"].sel(nonlocality=name))
+        ax.set_title(f"{name} (α = {alpha:g}): ξ = "
+                     f"{float(field['correlation_length']) / band_spacing:.2f} Δx\n"
+                     f"std f = {float(field['frictional_fraction_spread']):.3f}",
                      fontsize="medium")
     lower = fig.add_subplot(grid[1, :])
     curves = data.sel(phi=phi)
-    for name in names:
+    colours = {}
+    for name in data["nonlocality"].values:
         curve = curves.sel(nonlocality=name)
-        lower.plot(curve["imposed_stress"].values, curve["correlation_length"].values / spacing,
-                   "o-", ms=4, label=name)
+        line, = lower.plot(curve["imposed_stress"].values,
+                           curve["correlation_length"].values / spacing, "o-", ms=4,
+                           label=f"{name}, {data.attrs['n_x']} × {data.attrs['n_y']}")
+        colours[str(name)] = line.get_color()
+    if banded:
+        for name, field in zip(names, fields):
+            lower.plot(stress, float(field["correlation_length"]) / band_spacing, "*", ms=13,
+                       mec="k", color=colours.get(name, "k"),
+                       label=f"{name}, {lattice[0]} × {lattice[1]} (band run)")
     sb, sa = float(data["sigma_beta"].sel(phi=phi)), float(data["sigma_alpha"].sel(phi=phi))
     if np.isfinite(sb) and np.isfinite(sa):
         lower.axvspan(sb, sa, color="0.9", label="unstable branch σ_β < σ_in < σ_α")
-    lower.axvline(float(point["imposed_stress"]), color="tab:red", ls=":", lw=1.0,
-                  label="the run above")
+    lower.axvline(stress, color="tab:red", ls=":", lw=1.0, label="the runs above")
     lower.set_xscale("log")
     lower.set_xlabel("imposed stress σ_in [σ*]")
     lower.set_ylabel("correlation length ξ of f [Δx]")
     lower.grid(True, alpha=0.3)
-    lower.legend(fontsize="small")
-    fig.suptitle(f"Microstructure f at φ = {phi:.2f}, σ_in = "
-                 f"{float(point['imposed_stress']):.3g} σ*, {data.attrs['n_x']} × "
-                 f"{data.attrs['n_y']} particles", fontsize="medium")
+    lower.legend(fontsize="x-small", ncol=2)
+    fig.suptitle(f"Microstructure f at φ = {phi:.2f}, σ_in = {stress:.3g} σ*, "
+                 f"{lattice[0]} × {lattice[1]} particles", fontsize="medium")
     return fig

@@ -5,7 +5,10 @@ fractions φ, non-localities and the number of imposed stresses per flow curve;
 :func:`study_points` expands it into points, :func:`point_scene` turns a point into a DST scene
 (:mod:`suspsim.dst.scene`) and :func:`simulate_point` runs it with :func:`suspsim.dst.run.
 run_dst_scene`, whose run file keeps the time series, the steady-window means and the final
-per-particle snapshot (``particle_*``). Gathering and figures live in
+per-particle snapshot (``particle_*``). :func:`band_points` adds the band runs: the figure point (one φ, one stress) at chosen
+non-localities on a finer lattice, where moderate non-locality's diffusion length
+sqrt(α/(K_f γ̇)) (≈ 0.04 L_y on the unstable branch at φ = 0.54) spans about a lattice spacing.
+Gathering and figures live in
 :mod:`suspsim.stages.dst_gather` and :mod:`suspsim.stages.dst_figures`, so that editing them
 does not re-run the simulations (the rules' code fingerprints).
 
@@ -35,8 +38,10 @@ from __future__ import annotations
 import logging
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Mapping
+
+import numpy as np
 
 from ..dst.parameters import WyartCatesFluid
 from ..dst.run import run_dst_scene
@@ -127,9 +132,11 @@ def study_points(settings: Mapping[str, Any]) -> list[StudyPoint]:
     return points
 
 
-def find_point(settings: Mapping[str, Any], phi: float, name: str, index: int) -> StudyPoint:
-    """The point of (φ, non-locality name, stress index); InputError if the study has none."""
-    for point in study_points(settings):
+def find_point(settings: Mapping[str, Any], phi: float, name: str, index: int, *,
+               band: bool = False) -> StudyPoint:
+    """The point (``band``: the band run) of (φ, non-locality name, stress index); InputError
+    if the study has none."""
+    for point in (band_points(settings) if band else study_points(settings)):
         if (math.isclose(point.phi, float(phi), rel_tol=1e-12)
                 and point.nonlocality.name == name and point.index == int(index)):
             return point
@@ -137,13 +144,50 @@ def find_point(settings: Mapping[str, Any], phi: float, name: str, index: int) -
                      f"{index}", key="volume_fractions")
 
 
-def point_scene(settings: Mapping[str, Any], point: StudyPoint) -> dict:
+def figure_index(settings: Mapping[str, Any]) -> int:
+    """Index of the imposed stress of ``figure.phi`` nearest (in log) to ``figure.stress``.
+
+    Raises InputError when ``figure.phi`` is not one of the volume fractions.
+    """
+    phi = float(settings["figure"]["phi"])
+    if not any(math.isclose(phi, float(p), rel_tol=1e-9) for p in settings["volume_fractions"]):
+        raise InputError("dst.figure", f"phi = {phi} is not one of the study's volume fractions "
+                         f"{list(settings['volume_fractions'])}", key="phi")
+    stresses = phi_stresses(settings, phi)
+    return int(np.argmin(np.abs(np.log(stresses / float(settings["figure"]["stress"])))))
+
+
+def band_points(settings: Mapping[str, Any]) -> list[StudyPoint]:
+    """The band runs: the figure point (``figure.phi``, :func:`figure_index`) at each
+    non-locality named in ``bands.nonlocalities``, with the ``bands`` run lengths (their
+    lattice is ``bands.lattice``, :func:`point_scene` with ``band=True``). None without
+    volume fractions or band non-localities."""
+    bands = settings["bands"]
+    if not settings["volume_fractions"] or not bands["nonlocalities"]:
+        return []
+    kinds = {kind.name: kind for kind in nonlocalities(settings)}
+    missing = [name for name in bands["nonlocalities"] if name not in kinds]
+    if missing:
+        raise InputError("dst.bands", f"non-localities {missing} are not in dst.nonlocalities",
+                         key="nonlocalities")
+    phi, index = float(settings["figure"]["phi"]), figure_index(settings)
+    stress = float(phi_stresses(settings, phi)[index])
+    return [StudyPoint(phi, replace(kinds[name],
+                                    equilibration_strain=float(bands["equilibration_strain"]),
+                                    averaging_strain=float(bands["averaging_strain"])),
+                       index, stress)
+            for name in bands["nonlocalities"]]
+
+
+def point_scene(settings: Mapping[str, Any], point: StudyPoint, *, band: bool = False) -> dict:
     """The DST scene (a dict for :func:`~suspsim.dst.scene.dst_scene_from_dict`) of a point.
 
-    Lattice ``settings["lattice"]`` = (n_x, n_y): box [n_x/n_y, 1], resolution n_y. See the
-    module docstring for the density, sound speed, start and run length.
+    Lattice (n_x, n_y) = ``settings["lattice"]``, or ``settings["bands"]["lattice"]`` with
+    ``band``: box [n_x/n_y, 1], resolution n_y. See the module docstring for the density,
+    sound speed, start and run length.
     """
-    n_x, n_y = (int(n) for n in settings["lattice"])
+    lattice = settings["bands"]["lattice"] if band else settings["lattice"]
+    n_x, n_y = (int(n) for n in lattice)
     kind = point.nonlocality
     fluid = study_fluid(settings, point.phi, kind.alpha)
     law = fluid.steady_law()

@@ -39,7 +39,7 @@ from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.provenance import provenance
 from ..dst.study import REFERENCES, UNIT_SYSTEM
-from .dst import StudyPoint, study_fluid, study_points
+from .dst import StudyPoint, band_points, study_fluid, study_points
 
 log = logging.getLogger(__name__)
 
@@ -153,10 +153,14 @@ def correlation_length(x, y, f, period: float, spacing: float) -> float:
 
 
 def gather_flow_curves(runs: Sequence[xr.Dataset], settings: Mapping, *,
-                       sources: Sequence[str] | None = None) -> xr.Dataset:
+                       sources: Sequence[str] | None = None,
+                       bands: Sequence[xr.Dataset] = (),
+                       band_sources: Sequence[str] | None = None) -> xr.Dataset:
     """The flow-curve Dataset (module docstring) of the study ``settings`` (the config's
     ``dst`` block) from its run files, one per :func:`~suspsim.stages.dst.study_points` point
-    in that order.
+    in that order, and the band runs (:func:`~suspsim.stages.dst.band_points` order), whose
+    values get the prefix ``band_`` on the dimensions ``band_nonlocality`` and
+    ``band_particle``.
 
     Raises InputError when the number of runs differs from the points or a run's φ, α or
     imposed stress is not its point's.
@@ -169,7 +173,6 @@ def gather_flow_curves(runs: Sequence[xr.Dataset], settings: Mapping, *,
     names = list(dict.fromkeys(p.nonlocality.name for p in points))
     count = int(settings["stress_count"])
     n_particles = int(settings["lattice"][0]) * int(settings["lattice"][1])
-    n_bins = None
     shape = (len(phis), len(names), count)
     cells: dict[str, np.ndarray] = {}
 
@@ -180,34 +183,11 @@ def gather_flow_curves(runs: Sequence[xr.Dataset], settings: Mapping, *,
 
     stress = np.full((len(phis), count), np.nan)
     for point, run, source in zip(points, runs, sources):
-        _check(point, run, source)
         at = (phis.index(point.phi), names.index(point.nonlocality.name), point.index)
         stress[at[0], at[2]] = point.stress
-        for key, (name, _, _) in FROM_RUN.items():
-            cell(name)[at] = float(run[key])
-        scene = json.loads(run.attrs["scene"])
-        x, y = run["particle_x"].values, run["particle_y"].values
-        if x.size != n_particles:
-            raise InputError(source, f"{x.size} fluid particles, the study's lattice has "
-                                     f"{n_particles}")
-        for key, (name, _, _) in SNAPSHOT.items():
-            cell(name, (n_particles,))[at] = run[key].values
-        n_bins = run["y"].size if n_bins is None else n_bins
-        for key, (name, _, _) in PROFILES.items():
-            cell(name, (n_bins,))[at] = run[key].values
-        f = run["particle_frictional_fraction"].values
-        spacing = 1.0 / int(scene["resolution"])
-        cell("correlation_length")[at] = correlation_length(x, y, f, float(scene["box"][0]),
-                                                            spacing)
-        cell("frictional_fraction_spread")[at] = float(np.std(f))
-        cell("wall_time")[at] = float(run.attrs["wall_time_s"])
-        cell("steps")[at] = float(run.attrs["n_steps"])
-        law = study_fluid(settings, point.phi, 0.0).steady_law()
-        cell("lever_rule")[at] = _lever(law, point.stress, cells["wall_shear_rate"][at])
-        cell("wyart_cates_lever_rule")[at] = _lever(law, point.stress,
-                                                    cells["wyart_cates_shear_rate"][at])
-    cells["relative_deviation"] = cells["shear_rate"] / cells["wyart_cates_shear_rate"] - 1.0
-    cells["psi_sum"] = cells["psi1"] + cells["psi2"]
+        values = _point_values(point, run, source, settings, n_particles)
+        for name, value in values.items():
+            cell(name, np.shape(value))[at] = value
     dims = ("phi", "nonlocality", "stress_index")
     data = {}
     for table in (FROM_RUN, SNAPSHOT, PROFILES):
@@ -219,6 +199,9 @@ def gather_flow_curves(runs: Sequence[xr.Dataset], settings: Mapping, *,
         data[name] = (dims, cells[name], _attrs(long_name, scaled, comment,
                                                 units="s" if name == "wall_time" else "1"))
     data.update(_curves(settings, phis, stress))
+    if bands:
+        data.update(_band_variables(settings, bands, band_sources or
+                                    [f"band run {i}" for i in range(len(bands))]))
     kinds = {p.nonlocality.name: p.nonlocality for p in points}
     y_centres = runs[0]["y"].values
     coords = {
@@ -261,25 +244,105 @@ def gather_flow_curves(runs: Sequence[xr.Dataset], settings: Mapping, *,
         "momentum_time_ratio": float(settings["momentum_time_ratio"]),
         "perturbation": float(settings["perturbation"]), "seed": int(settings["seed"]),
         "configuration": json.dumps(dict(settings)),
-        "wall_time_s": float(np.nansum(cells["wall_time"])), "completed": 1, **prov}
+        "wall_time_s": float(np.nansum(cells["wall_time"])
+                             + (np.nansum(dataset["band_wall_time"].values) if bands else 0.0)),
+        "completed": 1, **prov}
+    if bands:
+        dataset.attrs.update(band_n_x=int(settings["bands"]["lattice"][0]),
+                             band_n_y=int(settings["bands"]["lattice"][1]))
     return dataset
 
 
+def _point_values(point: StudyPoint, run: xr.Dataset, source: str, settings: Mapping,
+                  n_particles: int) -> dict:
+    """Every per-point value of a run file: the run's means, snapshot and profiles, the band
+    measures, the lever rule, wall time and steps."""
+    _check(point, run, source)
+    scene = json.loads(run.attrs["scene"])
+    x, y = run["particle_x"].values, run["particle_y"].values
+    if x.size != n_particles:
+        raise InputError(source, f"{x.size} fluid particles, the study's lattice has "
+                                 f"{n_particles}")
+    values = {name: float(run[key]) for key, (name, _, _) in FROM_RUN.items()}
+    for table in (SNAPSHOT, PROFILES):
+        values.update({name: run[key].values for key, (name, _, _) in table.items()})
+    f = run["particle_frictional_fraction"].values
+    values["correlation_length"] = correlation_length(x, y, f, float(scene["box"][0]),
+                                                      1.0 / int(scene["resolution"]))
+    values["frictional_fraction_spread"] = float(np.std(f))
+    values["wall_time"] = float(run.attrs["wall_time_s"])
+    values["steps"] = float(run.attrs["n_steps"])
+    law = study_fluid(settings, point.phi, 0.0).steady_law()
+    values["lever_rule"] = _lever(law, point.stress, values["wall_shear_rate"])
+    values["wyart_cates_lever_rule"] = _lever(law, point.stress,
+                                              values["wyart_cates_shear_rate"])
+    values["relative_deviation"] = values["shear_rate"] / values["wyart_cates_shear_rate"] - 1
+    values["psi_sum"] = values["psi1"] + values["psi2"]
+    return values
+
+
+#: Per-point values the band runs keep (with the prefix band_).
+BAND_VALUES = ("shear_rate", "measured_stress", "wall_shear_rate", "psi1", "psi2",
+               "relative_deviation", "correlation_length", "frictional_fraction_spread",
+               "wall_time")
+
+
+def _band_variables(settings: Mapping, bands: Sequence[xr.Dataset],
+                    sources: Sequence[str]) -> dict:
+    points = band_points(settings)
+    if len(bands) != len(points):
+        raise InputError("gather_dst", f"{len(bands)} band run files for {len(points)} band "
+                                       "points")
+    n_particles = int(settings["bands"]["lattice"][0]) * int(settings["bands"]["lattice"][1])
+    values = [_point_values(p, run, source, settings, n_particles)
+              for p, run, source in zip(points, bands, sources)]
+    tables = {**{v[0]: (v[1], v[2], None) for v in FROM_RUN.values()}, **COMPUTED}
+    out = {}
+    for name in BAND_VALUES:
+        long_name, scaled, _ = tables[name]
+        out[f"band_{name}"] = ("band_nonlocality", np.array([v[name] for v in values]),
+                               _attrs(f"band run: {long_name}", scaled,
+                                      units="s" if name == "wall_time" else "1"))
+    for name, long_name, scaled in SNAPSHOT.values():
+        out[f"band_{name}"] = (("band_nonlocality", "band_particle"),
+                               np.array([v[name] for v in values]),
+                               _attrs(f"band run: {long_name}", scaled))
+    out["band_nonlocality"] = ("band_nonlocality",
+                               np.array([p.nonlocality.name for p in points], dtype=object),
+                               {"long_name": "non-locality of the band run"})
+    out["band_phi"] = ((), points[0].phi, _attrs("volume fraction of the band runs", None))
+    out["band_stress"] = ((), points[0].stress, _attrs("imposed stress of the band runs",
+                                                       _STRESS))
+    out["band_stress_index"] = ((), points[0].index,
+                                _attrs("index of the band runs' stress on the grid of band_phi",
+                                       None))
+    return out
+
+
 def write_flow_curves(run_files: Sequence[str | os.PathLike], out_nc: str | os.PathLike,
-                      settings: Mapping) -> None:
-    """Gather ``run_files`` (study-point order) into ``out_nc`` atomically."""
-    runs = []
-    for path in run_files:
-        try:
-            runs.append(xr.load_dataset(path))
-        except (OSError, ValueError) as err:
-            raise InputError(str(path), f"cannot read the run file: {err}") from err
-    dataset = gather_flow_curves(runs, settings, sources=[str(p) for p in run_files])
-    encoding = {name: {"_FillValue": None} for name in dataset.coords if name != "nonlocality"}
+                      settings: Mapping, *,
+                      band_files: Sequence[str | os.PathLike] = ()) -> None:
+    """Gather ``run_files`` (study-point order) and ``band_files`` (band-point order) into
+    ``out_nc`` atomically."""
+    runs, bands = _load(run_files), _load(band_files)
+    dataset = gather_flow_curves(runs, settings, sources=[str(p) for p in run_files],
+                                 bands=bands, band_sources=[str(p) for p in band_files])
+    encoding = {name: {"_FillValue": None} for name in dataset.coords
+                if name not in ("nonlocality", "band_nonlocality")}
     with atomic_path(out_nc) as tmp:
         dataset.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
     log.info("wrote %s: %d points, %.0f s of runs", out_nc, len(runs),
              dataset.attrs["wall_time_s"])
+
+
+def _load(paths) -> list[xr.Dataset]:
+    out = []
+    for path in paths:
+        try:
+            out.append(xr.load_dataset(path))
+        except (OSError, ValueError) as err:
+            raise InputError(str(path), f"cannot read the run file: {err}") from err
+    return out
 
 
 def _check(point: StudyPoint, run: xr.Dataset, source: str) -> None:

@@ -11,8 +11,8 @@ import xarray as xr
 from suspsim.dst.scene import dst_scene_from_dict
 from suspsim.dst.study import MODERATE_NONLOCALITY, STRONG_NONLOCALITY, spanning_stresses
 from suspsim.errors import InputError
-from suspsim.stages.dst import (find_point, nonlocalities, phi_stresses, point_scene,
-                                study_fluid, study_points)
+from suspsim.stages.dst import (band_points, figure_index, find_point, nonlocalities,
+                                phi_stresses, point_scene, study_fluid, study_points)
 from suspsim.stages.dst_figures import (figure_point, flow_curve_view, splitting_view,
                                         write_dst_figures)
 from suspsim.stages.dst_gather import correlation_length, gather_flow_curves, write_flow_curves
@@ -26,7 +26,9 @@ SETTINGS = {
     "stress_count": 4, "stress_range": [0.2, 40.0], "lattice": [13, 6],
     "momentum_time_ratio": 0.1, "perturbation": 0.01, "seed": 1,
     "fluid": {"phi_m": 0.562, "phi_0": 0.693, "beta": 2.0, "K_f": 1.0},
-    "figure": {"phi": 0.54, "stress": 1.25}, "threads": 1}
+    "figure": {"phi": 0.54, "stress": 1.25}, "threads": 1,
+    "bands": {"nonlocalities": ["zero", "weak"], "lattice": [13, 9], "equilibration_strain": 3,
+              "averaging_strain": 2}}
 
 
 def test_points_cover_every_phi_nonlocality_and_spanning_stress_once():
@@ -77,6 +79,25 @@ def test_point_scene_is_a_valid_dst_scene_with_the_study_set_up():
     upper = float(law.branch_stress(rate, "upper"))
     assert scene.numerics.sound_speed == pytest.approx(
         math.sqrt(upper / (scene.numerics.density * 0.01)))
+
+
+def test_band_points_are_the_figure_point_on_the_band_lattice():
+    index = figure_index(SETTINGS)
+    stresses = phi_stresses(SETTINGS, 0.54)
+    assert index == int(np.argmin(np.abs(np.log(stresses / 1.25))))
+    bands = band_points(SETTINGS)
+    assert [(p.phi, p.nonlocality.name, p.index) for p in bands] == [(0.54, "zero", index),
+                                                                     (0.54, "weak", index)]
+    assert bands[1].nonlocality.alpha == 1e-3 and bands[0].stress == stresses[index]
+    scene = dst_scene_from_dict(point_scene(SETTINGS, bands[0], band=True))
+    assert (scene.geometry.n_x, scene.geometry.n_y) == (13, 9)
+    assert (scene.run.strain, scene.run.transient) == (5.0, 3.0)
+    assert find_point(SETTINGS, 0.54, "weak", index, band=True) == bands[1]
+    assert band_points({**SETTINGS, "bands": {**SETTINGS["bands"], "nonlocalities": []}}) == []
+    with pytest.raises(InputError, match="not in dst.nonlocalities"):
+        band_points({**SETTINGS, "bands": {**SETTINGS["bands"], "nonlocalities": ["other"]}})
+    with pytest.raises(InputError, match="not one of the study's volume fractions"):
+        figure_index({**SETTINGS, "figure": {"phi": 0.5, "stress": 1.25}})
 
 
 def test_perturbed_start_has_the_requested_rms_and_is_reproducible():
@@ -131,15 +152,16 @@ def test_correlation_length_is_periodic_in_x():
         correlation_length(x, y[:-1], field, period, dx)
 
 
-def fake_run(settings, point, deviation=0.01, psi=(0.3, 0.2), rng=None):
+def fake_run(settings, point, deviation=0.01, psi=(0.3, 0.2), rng=None, band=False):
     """A run dataset of ``point`` laid out as suspsim.dst.run writes it: the domain-averaged
     rate is (1 + deviation) x the Wyart-Cates rate, the stress the imposed one."""
     rng = rng or np.random.default_rng(0)
-    scene = dst_scene_from_dict(point_scene(settings, point))
+    scene = dst_scene_from_dict(point_scene(settings, point, band=band))
     fluid = scene.fluid
     rate = fluid.shear_rate(point.stress)
-    x, y, _, _ = _lattice(*settings["lattice"])
-    n_y = settings["lattice"][1]
+    lattice = settings["bands"]["lattice"] if band else settings["lattice"]
+    x, y, _, _ = _lattice(*lattice)
+    n_y = lattice[1]
     turning = fluid.steady_law().turning_points()
     q = ((point.stress - turning.sigma_beta) / (turning.sigma_alpha - turning.sigma_beta)
          if turning else math.nan)
@@ -169,16 +191,30 @@ def fake_run(settings, point, deviation=0.01, psi=(0.3, 0.2), rng=None):
                              "n_steps": 1000})
 
 
+def _band_runs():
+    """Band runs: f banded in rows of 3 for 'weak', particle noise for 'zero'."""
+    runs = []
+    for point in band_points(SETTINGS):
+        run = fake_run(SETTINGS, point, band=True)
+        y = run["particle_y"].values
+        if point.nonlocality.name == "weak":
+            run["particle_frictional_fraction"].values[:] = np.floor(y * 9 / 3) % 2
+        runs.append(run)
+    return runs
+
+
 @pytest.fixture(scope="module")
 def gathered():
     points = study_points(SETTINGS)
-    return gather_flow_curves([fake_run(SETTINGS, p) for p in points], SETTINGS)
+    return gather_flow_curves([fake_run(SETTINGS, p) for p in points], SETTINGS,
+                              bands=_band_runs())
 
 
 def test_gather_places_every_run_and_adds_the_steady_curve(gathered):
     data = gathered
     assert data["shear_rate"].dims == ("phi", "nonlocality", "stress_index")
     assert data.sizes == {"phi": 2, "nonlocality": 3, "stress_index": 4, "particle": 78,
+                          "band_nonlocality": 2, "band_particle": 117,
                           "y": 6, "curve_point": 400}
     assert list(data["nonlocality"].values) == ["strong", "zero", "weak"]
     assert data["alpha"].values.tolist() == [STRONG_NONLOCALITY, 0.0, 1e-3]
@@ -201,8 +237,15 @@ def test_gather_places_every_run_and_adds_the_steady_curve(gathered):
                     if 0 < q[k] < 1 else math.nan)
         assert point["lever_rule"].values[k] == pytest.approx(expected, nan_ok=True)
     assert np.all(np.isfinite(data["correlation_length"].values))
+    # band runs: their own lattice; banded f is longer-ranged than particle noise
+    assert data["band_particle_x"].shape == (2, 13 * 9)
+    band_xi = data["band_correlation_length"]
+    assert float(band_xi.sel(band_nonlocality="weak")) > 2 * float(
+        band_xi.sel(band_nonlocality="zero"))
+    assert float(data["band_stress"]) == pytest.approx(phi_stresses(SETTINGS, 0.54)[
+        figure_index(SETTINGS)])
     for name, variable in data.variables.items():
-        if name not in ("nonlocality",):
+        if name not in ("nonlocality", "band_nonlocality"):
             assert "units" in variable.attrs and "long_name" in variable.attrs, name
 
 
@@ -223,8 +266,12 @@ def flow_curves_file(tmp_path_factory):
     for k, point in enumerate(study_points(SETTINGS)):
         files.append(folder / f"run{k}.nc")
         fake_run(SETTINGS, point).to_netcdf(files[-1])
+    band_files = []
+    for k, run in enumerate(_band_runs()):
+        band_files.append(folder / f"band{k}.nc")
+        run.to_netcdf(band_files[-1])
     out = folder / "flow_curves.nc"
-    write_flow_curves(files, out, SETTINGS)
+    write_flow_curves(files, out, SETTINGS, band_files=band_files)
     return out
 
 
