@@ -5,12 +5,13 @@ fractions φ, non-localities and the number of imposed stresses per flow curve;
 :func:`study_points` expands it into points, :func:`point_scene` turns a point into a DST scene
 (:mod:`suspsim.dst.scene`) and :func:`simulate_point` runs it with :func:`suspsim.dst.run.
 run_dst_scene`, whose run file keeps the time series, the steady-window means and the final
-per-particle snapshot (``particle_*``). :func:`band_points` adds the band runs: the figure point (one φ, one stress) at chosen
-non-localities on a finer lattice, where moderate non-locality's diffusion length
-sqrt(α/(K_f γ̇)) (≈ 0.04 L_y on the unstable branch at φ = 0.54) spans about a lattice spacing.
-Gathering and figures live in
-:mod:`suspsim.stages.dst_gather` and :mod:`suspsim.stages.dst_figures`, so that editing them
-does not re-run the simulations (the rules' code fingerprints).
+per-particle snapshot (``particle_*``). :func:`band_points` adds the band runs: the figure
+point (one φ, one stress) at chosen non-localities on a finer lattice, where moderate
+non-locality's diffusion length sqrt(α/(K_f γ̇)), 0.026–0.043 L_y on the unstable branch at
+φ = 0.54 (γ̇ from γ̇_max = 0.0285 to γ̇_min = 0.0110 σ*/η_s), spans about a lattice spacing.
+Gathering and figures live in :mod:`suspsim.stages.dst_gather` and
+:mod:`suspsim.stages.dst_figures`, so that editing them does not re-run the simulations (the
+rules' code fingerprints).
 
 Scaled units as :mod:`suspsim.dst.study`: L_y = η_s = σ* = 1; stresses in σ*, α in
 L_y² σ*/η_s. Per point (SPEC §5.4, §5.6):
@@ -24,8 +25,9 @@ L_y² σ*/η_s. Per point (SPEC §5.4, §5.6):
   :data:`~suspsim.dst.study.MODERATE_NONLOCALITY` (1e−8 m²/s) or
   :data:`~suspsim.dst.study.LOCAL` (0);
 * the density is ρ = ε σ_in/(K_f γ̇_WC²), ε = K_f γ̇ ρ L_y²/η = ``momentum_time_ratio`` (the
-  scene's ``numerics.density: auto``, as :func:`~suspsim.dst.study.flow_curve`), the sound speed :func:`suspsim.dst.study.splitting_sound_speed`
-  (Morris, raised to the upper-branch stress at γ̇_WC where a split particle can reach it);
+  scene's ``numerics.density: auto``, as :func:`~suspsim.dst.study.flow_curve`), the sound
+  speed :func:`suspsim.dst.study.splitting_sound_speed` (Morris, raised to the upper-branch
+  stress at γ̇_WC where a split particle can reach it);
 * the start is f = f̂(σ_in) plus uncorrelated Gaussian noise of rms ``perturbation`` (seeded by
   ``seed``), V_w = γ̇_WC L_y — the start of :func:`suspsim.dst.study.stress_splitting`, for
   every non-locality, so the three differ in α only;
