@@ -32,8 +32,9 @@ L_y² σ*/η_s. Per point (SPEC §5.4, §5.6):
   ``seed``), V_w = γ̇_WC L_y — the start of :func:`suspsim.dst.study.stress_splitting`, for
   every non-locality, so the three differ in α only;
 * the run lasts the non-locality's ``equilibration_strain`` + ``averaging_strain`` (nominal
-  strain γ̇_WC t); the first is discarded, the second averaged (batch means over whole strain
-  units when ≥ 8 of them, else Flyvbjerg–Petersen blocking).
+  strain γ̇_WC t) on the unstable branch, at most the ``stable_branch`` strains off it
+  (:func:`study_points`); the first is discarded, the second averaged (batch means over whole
+  strain units when ≥ 8 of them, else Flyvbjerg–Petersen blocking).
 """
 from __future__ import annotations
 
@@ -122,15 +123,36 @@ def phi_stresses(settings: Mapping[str, Any], phi: float):
                              low=low, high=high)
 
 
+def on_unstable_branch(settings: Mapping[str, Any], phi: float, stress: float) -> bool:
+    """True where σ_β < σ_in < σ_α on a flowing S-curve (φ < φ_m): the homogeneous state is
+    unstable at zero non-locality there (SPEC §5.6)."""
+    turning = study_fluid(settings, phi, 0.0).steady_law().turning_points()
+    return (turning is not None and math.isfinite(turning.sigma_alpha)
+            and turning.sigma_beta < stress < turning.sigma_alpha)
+
+
 def study_points(settings: Mapping[str, Any]) -> list[StudyPoint]:
-    """Every point of the study, φ-major, then non-locality, then stress index."""
+    """Every point of the study, φ-major, then non-locality, then stress index.
+
+    Off the unstable branch (:func:`on_unstable_branch` false) a point runs for the
+    ``stable_branch`` strains where they are shorter than its non-locality's: there the
+    perturbed homogeneous state is linearly stable, and the perturbation relaxes at the rate
+    K_f γ̇ (1 − g), g = (d ln f̂/d ln σ)(d ln η/d ln f) < 1 the gain of the per-particle loop,
+    so the long runs a split needs are spent for nothing.
+    """
     points = []
     kinds = nonlocalities(settings)
+    stable = settings["stable_branch"]
     for phi in settings["volume_fractions"]:
         stresses = phi_stresses(settings, phi)
         for kind in kinds:
-            points.extend(StudyPoint(float(phi), kind, index, float(stress))
-                          for index, stress in enumerate(stresses))
+            short = replace(kind, equilibration_strain=min(kind.equilibration_strain,
+                                                           float(stable["equilibration_strain"])),
+                            averaging_strain=min(kind.averaging_strain,
+                                                 float(stable["averaging_strain"])))
+            points.extend(StudyPoint(float(phi), kind if on_unstable_branch(settings, phi, s)
+                                     else short, index, float(s))
+                          for index, s in enumerate(stresses))
     return points
 
 

@@ -39,7 +39,7 @@ from ..errors import InputError
 from ..io.atomic import atomic_path
 from ..io.provenance import provenance
 from ..dst.study import REFERENCES, UNIT_SYSTEM
-from .dst import StudyPoint, band_points, study_fluid, study_points
+from .dst import StudyPoint, band_points, nonlocalities, study_fluid, study_points
 
 log = logging.getLogger(__name__)
 
@@ -110,6 +110,8 @@ COMPUTED = {
                            "the band criterion (suspsim.stages.dst_gather.correlation_length)"),
     "frictional_fraction_spread": ("standard deviation of f over the particles of the final "
                                    "snapshot", None, None),
+    "equilibration_strain": ("nominal strain gdot_WC t discarded", None, None),
+    "averaging_strain": ("nominal strain gdot_WC t averaged", None, None),
     "wall_time": ("wall-clock time of the run", None, None),
     "steps": ("predictor-corrector steps of the run", None, None),
 }
@@ -202,7 +204,7 @@ def gather_flow_curves(runs: Sequence[xr.Dataset], settings: Mapping, *,
     if bands:
         data.update(_band_variables(settings, bands, band_sources or
                                     [f"band run {i}" for i in range(len(bands))]))
-    kinds = {p.nonlocality.name: p.nonlocality for p in points}
+    kinds = {kind.name: kind for kind in nonlocalities(settings)}
     y_centres = runs[0]["y"].values
     coords = {
         "phi": ("phi", np.array(phis), _attrs("solid volume fraction", None)),
@@ -214,11 +216,6 @@ def gather_flow_curves(runs: Sequence[xr.Dataset], settings: Mapping, *,
                           "units": "1"}),
         "alpha": ("nonlocality", np.array([kinds[n].alpha for n in names]),
                   _attrs("diffusivity alpha of f (non-locality)", "L_y2 sigma_star eta_s-1")),
-        "equilibration_strain": ("nonlocality",
-                                 np.array([kinds[n].equilibration_strain for n in names]),
-                                 _attrs("nominal strain gdot_WC t discarded", None)),
-        "averaging_strain": ("nonlocality", np.array([kinds[n].averaging_strain for n in names]),
-                             _attrs("nominal strain gdot_WC t averaged", None)),
         "imposed_stress": (("phi", "stress_index"), stress,
                            _attrs("imposed shear stress sigma_in on the top wall", _STRESS)),
         "y": ("y", y_centres, _attrs("bin centre across the gap (walls at y = 0 and 1)",
@@ -270,6 +267,8 @@ def _point_values(point: StudyPoint, run: xr.Dataset, source: str, settings: Map
     values["correlation_length"] = correlation_length(x, y, f, float(scene["box"][0]),
                                                       1.0 / int(scene["resolution"]))
     values["frictional_fraction_spread"] = float(np.std(f))
+    values["equilibration_strain"] = point.nonlocality.equilibration_strain
+    values["averaging_strain"] = point.nonlocality.averaging_strain
     values["wall_time"] = float(run.attrs["wall_time_s"])
     values["steps"] = float(run.attrs["n_steps"])
     law = study_fluid(settings, point.phi, 0.0).steady_law()

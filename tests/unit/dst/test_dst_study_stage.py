@@ -27,6 +27,7 @@ SETTINGS = {
     "momentum_time_ratio": 0.1, "perturbation": 0.01, "seed": 1,
     "fluid": {"phi_m": 0.562, "phi_0": 0.693, "beta": 2.0, "K_f": 1.0},
     "figure": {"phi": 0.54, "stress": 1.25}, "threads": 1,
+    "stable_branch": {"equilibration_strain": 1.5, "averaging_strain": 1.0},
     "bands": {"nonlocalities": ["zero", "weak"], "lattice": [13, 9], "equilibration_strain": 3,
               "averaging_strain": 2}}
 
@@ -47,6 +48,13 @@ def test_points_cover_every_phi_nonlocality_and_spanning_stress_once():
               if turning.sigma_beta < s < turning.sigma_alpha]
     assert len(inside) == 1
     assert find_point(SETTINGS, 0.54, "weak", 3) == points[-1]
+    # off the unstable branch a point runs at most the stable-branch strains
+    for p in points:
+        unstable = p.phi == 0.54 and turning.sigma_beta < p.stress < turning.sigma_alpha
+        full = next(k for k in nonlocalities(SETTINGS) if k.name == p.nonlocality.name)
+        assert (p.nonlocality.equilibration_strain, p.nonlocality.averaging_strain) == (
+            (full.equilibration_strain, full.averaging_strain) if unstable
+            else (min(full.equilibration_strain, 1.5), min(full.averaging_strain, 1.0)))
     with pytest.raises(InputError):
         find_point(SETTINGS, 0.50, "weak", 0)
 
@@ -66,7 +74,7 @@ def test_nonlocality_names_map_to_the_study_constants_and_bad_entries_fail():
 
 
 def test_point_scene_is_a_valid_dst_scene_with_the_study_set_up():
-    point = find_point(SETTINGS, 0.54, "zero", 1)
+    point = find_point(SETTINGS, 0.54, "zero", 2)  # on the unstable branch
     scene = dst_scene_from_dict(point_scene(SETTINGS, point))
     assert (scene.geometry.n_x, scene.geometry.n_y) == (13, 6)
     assert scene.fluid.alpha == 0.0 and scene.flow.stress == pytest.approx(point.stress)
