@@ -315,3 +315,42 @@ def test_each_figure_is_drawn(tmp_path, flow_curves_file, name):
         assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(ValueError, match="unknown dst figure"):
         write_dst_figures(flow_curves_file, {"other": str(path)}, phi=0.54, stress=1.25)
+
+
+def test_a_density_error_restarts_the_point_with_a_faster_sound_speed(tmp_path, monkeypatch):
+    import suspsim.stages.dst as stage
+    from suspsim.errors import NumericalError
+
+    point = find_point(SETTINGS, 0.54, "zero", 2)
+    scene = point_scene(SETTINGS, point)
+    speeds = []
+
+    def failing(built, out, threads=None):
+        speeds.append(built.numerics.sound_speed)
+        if len(speeds) < 3:
+            raise NumericalError("DST run stopped: density error max|rho/rho0 - 1| exceeds")
+
+    monkeypatch.setattr(stage, "run_dst_scene", failing)
+    stage.simulate_point(scene, tmp_path / "run.nc")
+    c = scene["numerics"]["sound_speed"]
+    assert speeds == pytest.approx([c, 2 * c, 4 * c])  # the caller's scene is left alone
+    speeds.clear()
+
+    def always(built, out, threads=None):
+        speeds.append(built.numerics.sound_speed)
+        raise NumericalError("density error")
+
+    monkeypatch.setattr(stage, "run_dst_scene", always)
+    with pytest.raises(NumericalError):
+        stage.simulate_point(scene, tmp_path / "run.nc")
+    assert len(speeds) == 3
+    speeds.clear()
+
+    def jammed(built, out, threads=None):
+        speeds.append(built.numerics.sound_speed)
+        raise NumericalError("a particle jammed")
+
+    monkeypatch.setattr(stage, "run_dst_scene", jammed)
+    with pytest.raises(NumericalError, match="jammed"):
+        stage.simulate_point(scene, tmp_path / "run.nc")
+    assert len(speeds) == 1
