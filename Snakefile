@@ -17,6 +17,7 @@ include: "workflow/rules/pack.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/gather.smk"
 include: "workflow/rules/speed_error.smk"
+include: "workflow/rules/dst.smk"
 
 
 rule all:

@@ -89,9 +89,19 @@ def report(tmp_path_factory):
     return study, study / "report.html"
 
 
+#: Rule files of the studies that are not the material pipeline (their figures are not in the
+#: smoke study's report, and their own workflow tests run them).
+OTHER_STUDIES = {"speed_error", "dst"}
+
+
 def test_every_report_output_of_the_rules_is_parsed():
-    text = "".join(p.read_text() for p in (REPO / "workflow/rules").glob("*.smk"))
-    assert len(FIGURES) == text.count("report(") > 0
+    """Every report() of the material pipeline's rule files is in FIGURES, so the smoke
+    study's report is checked for it; the other studies' rule files hold the rest."""
+    calls = {p.stem: p.read_text().count("report(")
+             for p in (REPO / "workflow/rules").glob("*.smk")}
+    material = sum(n for stem, n in calls.items() if stem not in OTHER_STUDIES)
+    assert len(FIGURES) == material > 0
+    assert all(calls.get(stem, 0) > 0 for stem in OTHER_STUDIES)
     assert all(caption.endswith(".rst") for _, caption in FIGURES.values())
 
 

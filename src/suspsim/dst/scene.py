@@ -64,7 +64,8 @@ class DSTRunSpec:
     """Run settings, resolved: ``strain`` [1] or ``time`` [T] (the other None),
     ``output_interval`` and ``transient`` in the run-length unit, ``checkpoint_interval_s``
     [s wall clock], ``profile_bins``, ``threads`` (None: all cores), ``initial_fraction``
-    (None: the flow's steady start)."""
+    (None: the flow's steady start), ``perturbation`` (rms of the Gaussian noise on the initial
+    f [1]) and its generator's ``seed``."""
 
     strain: float | None
     time: float | None
@@ -74,6 +75,8 @@ class DSTRunSpec:
     profile_bins: int
     threads: int | None
     initial_fraction: float | None
+    perturbation: float = 0.0
+    seed: int = 1
 
     @property
     def length(self) -> float:
@@ -120,13 +123,25 @@ class DSTScene(RunTimes):
         return self.nominal_shear_rate
 
     def build(self, *, threads: int | None = None):
-        """A fresh :class:`~suspsim.dst.simulation.DSTSimulation` of this scene."""
+        """A fresh :class:`~suspsim.dst.simulation.DSTSimulation` of this scene.
+
+        With ``run.perturbation`` p > 0 each fluid particle's initial f becomes
+        clip(f + p N(0, 1), 0, 1), N from ``numpy.random.default_rng(run.seed)``, after the
+        flow's start is set (so V_w keeps the unperturbed rate), as
+        :func:`suspsim.dst.study.stress_splitting` starts its runs.
+        """
         from .simulation import DSTSimulation
 
         f0 = self.run.initial_fraction
-        return DSTSimulation(self.fluid, self.flow, self.geometry, self.numerics,
-                             threads=threads,
-                             initial_fraction=None if f0 is None else (lambda y: f0))
+        sim = DSTSimulation(self.fluid, self.flow, self.geometry, self.numerics,
+                            threads=threads,
+                            initial_fraction=None if f0 is None else (lambda y: f0))
+        if self.run.perturbation > 0:
+            rng = np.random.default_rng(self.run.seed)
+            fraction = sim.f_all[:sim.n_fluid]
+            sim.set_state(fraction=np.clip(
+                fraction + self.run.perturbation * rng.standard_normal(sim.n_fluid), 0.0, 1.0))
+        return sim
 
     def to_dict(self) -> dict:
         """The complete scene, defaults included, as plain JSON-able data."""
@@ -275,7 +290,8 @@ def _run(run: dict, kind: str, resolution: int, fail) -> DSTRunSpec:
                       checkpoint_interval_s=float(run["checkpoint_interval_s"]),
                       profile_bins=bins, threads=None if run["threads"] == "all"
                       else int(run["threads"]),
-                      initial_fraction=None if f0 == "steady" else float(f0))
+                      initial_fraction=None if f0 == "steady" else float(f0),
+                      perturbation=float(run["perturbation"]), seed=int(run["seed"]))
 
 
 def _run_dict(run: DSTRunSpec) -> dict:

@@ -422,6 +422,23 @@ def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
     return dataset
 
 
+def splitting_sound_speed(law, stress: float, density: float, gap: float = 1.0,
+                          tolerance: float = 0.01) -> float:
+    """Sound speed [L/T] for a stress-controlled run that may split (:func:`stress_splitting`).
+
+    c = max(10 γ̇ L_y, sqrt(σ_in/(ρ δ)), sqrt(σ2/(ρ δ))): the Morris 1997 criteria at the
+    Wyart–Cates rate γ̇ = γ̇_WC(σ_in) of ``law`` (a :class:`~suspsim.rheology.wyart_cates.
+    WyartCates`) and density tolerance δ, raised to the upper-branch stress σ2 at γ̇, the
+    largest stress a split particle carries. Where the upper branch has no such rate (σ2
+    NaN: stable lower branch below γ̇_min, CST) the Morris value alone.
+    """
+    rate = float(law.shear_rate(stress))
+    sound = max(10.0 * rate * gap, math.sqrt(stress / (density * tolerance)))
+    upper = float(law.branch_stress(rate, "upper")) if law.turning_points() else math.nan
+    return max(sound, math.sqrt(upper / (density * tolerance))) if math.isfinite(upper) \
+        else sound
+
+
 def _split_point(fluid, law, geometry, stress, *, epsilon, perturbation, seed,
                  equilibration_strain, averaging_strain, samples, n_blocks, threads) -> dict:
     """One split run; the record of :func:`stress_splitting`."""
@@ -429,9 +446,7 @@ def _split_point(fluid, law, geometry, stress, *, epsilon, perturbation, seed,
     turning = law.turning_points()
     rate = fluid.shear_rate(stress)
     density = epsilon * stress / (fluid.K_f * rate ** 2)
-    upper = float(law.branch_stress(rate, "upper"))
-    morris = max(10.0 * rate * geometry.gap, math.sqrt(stress / (density * 0.01)))
-    sound = max(morris, math.sqrt(upper / (density * 0.01)))
+    sound = splitting_sound_speed(law, stress, density, geometry.gap)
     sim = DSTSimulation(fluid, StressCouette(stress), geometry,
                         Numerics(density=density, sound_speed=sound), threads=threads)
     rng = np.random.default_rng(seed)

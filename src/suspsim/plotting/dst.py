@@ -38,6 +38,15 @@ def plot_flow_curves(datasets, *, labels=None, residuals: bool = True) -> Figure
     else:
         fig = Figure(figsize=(6.4, 5.2), layout="constrained")
         ax, lower = fig.subplots(), None
+    draw_flow_curves(ax, lower, datasets, labels=labels)
+    return fig
+
+
+def draw_flow_curves(ax, lower, datasets, *, labels=None, title: str | None = None) -> None:
+    """Draw :func:`plot_flow_curves` into ``ax`` (and the residuals into ``lower`` unless None).
+
+    ``title`` replaces the default title (which names the non-localities α of the data).
+    """
     colours = [colormaps["tab10"](k % 10) for k in range(len(datasets))]
     for k, (data, colour) in enumerate(zip(datasets, colours)):
         law = steady_law(data)
@@ -81,9 +90,9 @@ def plot_flow_curves(datasets, *, labels=None, residuals: bool = True) -> Figure
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize="small", loc="lower right")
     alphas = sorted({float(d.attrs["alpha"]) for d in datasets})
-    ax.set_title("Stress-controlled 2D SPH (markers) vs steady Wyart–Cates (lines)\n"
-                 "non-locality α = " + ", ".join(f"{a:g}" for a in alphas) + " L_y²σ*/η_s",
-                 fontsize="medium")
+    ax.set_title(title or ("Stress-controlled 2D SPH (markers) vs steady Wyart–Cates (lines)\n"
+                           "non-locality α = " + ", ".join(f"{a:g}" for a in alphas)
+                           + " L_y²σ*/η_s"), fontsize="medium")
     if lower is not None:
         lower.axhline(0.0, color="0.5", lw=0.8)
         lower.set_xscale("log")
@@ -91,7 +100,6 @@ def plot_flow_curves(datasets, *, labels=None, residuals: bool = True) -> Figure
         lower.set_ylabel("⟨γ̇⟩/γ̇_WC(σ_in) − 1 [1]")
         lower.set_title("relative deviation (dotted: turning points)", fontsize="small")
         lower.grid(True, alpha=0.3)
-    return fig
 
 
 def _values(data: xr.Dataset, name: str) -> np.ndarray | None:
@@ -135,4 +143,138 @@ def plot_branch_split(data: xr.Dataset) -> Figure:
                  f"{a['n_x']} × {a['n_y']} particles", fontsize="medium")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small", loc="center left")
+    return fig
+
+
+# ------------------------------------------------------------------ the dst study's figures
+def _curve(ax, data: xr.Dataset, phi: float) -> None:
+    """The steady Wyart–Cates curve of ``phi`` from a gathered study (solid stable, dashed
+    unstable) and its turning stresses (dotted)."""
+    rate = data["curve_shear_rate"].sel(phi=phi).values
+    sigma = data["curve_stress"].values
+    unstable = data["curve_log_slope"].sel(phi=phi).values < 0
+    ax.plot(np.where(unstable, np.nan, rate), sigma, "k-", lw=1.2, label="Wyart–Cates, stable")
+    ax.plot(np.where(unstable | np.roll(unstable, 1) | np.roll(unstable, -1), rate, np.nan),
+            sigma, "k--", lw=1.0, label="Wyart–Cates, unstable")
+    for name in ("sigma_beta", "sigma_alpha"):
+        value = float(data[name].sel(phi=phi))
+        if np.isfinite(value):
+            ax.axhline(value, color="0.5", ls=":", lw=0.8)
+
+
+def plot_particle_scatter(data: xr.Dataset, phi: float, index: int) -> Figure:
+    """Every particle's (γ̇_i, σ_i) over the steady curve, one panel per non-locality (seed 002
+    Fig. 4 d–f).
+
+    ``data``: the gathered dst study (:func:`suspsim.stages.dst_gather.gather_flow_curves`);
+    the run at ``phi`` and stress index ``index``. Dots: the final snapshot's particles,
+    coloured by f; star: that run's domain average (⟨γ̇⟩, ⟨σ⟩); open circles: the domain
+    averages of the other stresses of ``phi``; dotted: σ_β, σ_α. Log–log (particles with
+    γ̇_i = 0 or σ_i = 0 are left out). No file I/O.
+    """
+    names = list(data["nonlocality"].values)
+    fig = Figure(figsize=(4.2 * len(names) + 0.8, 4.4), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(names), sharex=True, sharey=True))
+    point = data.sel(phi=phi).isel(stress_index=index)
+    dots = None
+    for ax, name in zip(axes, names):
+        run = point.sel(nonlocality=name)
+        _curve(ax, data, phi)
+        rate, sigma = run["particle_shear_rate"].values, run["particle_stress"].values
+        keep = (rate > 0) & (sigma > 0)
+        dots = ax.scatter(rate[keep], sigma[keep], c=run["particle_frictional_fraction"].values[
+            keep], s=7, cmap="viridis", vmin=0.0, vmax=1.0, label="particles (final snapshot)")
+        curve = data.sel(phi=phi, nonlocality=name)
+        ax.plot(curve["shear_rate"].values, curve["measured_stress"].values, "o", ms=5,
+                mfc="none", mec="tab:blue", label="domain averages, all σ_in")
+        ax.plot(float(run["shear_rate"]), float(run["measured_stress"]), "*", ms=14,
+                color="tab:red", mec="k", label="domain average, this run")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.grid(True, alpha=0.3)
+        ax.set_xlabel("shear rate γ̇ [σ*/η_s]")
+        ax.set_title(f"{name} (α = {float(run['alpha']):g}): ψ1 = {float(run['psi1']):.2f}, "
+                     f"ψ2 = {float(run['psi2']):.2f}", fontsize="medium")
+    axes[0].set_ylabel("shear stress σ [σ*]")
+    axes[0].legend(fontsize="x-small", loc="upper left")
+    fig.colorbar(dots, ax=list(axes), label="frictional fraction f [1]", shrink=0.9)
+    fig.suptitle(f"Particles over the flow curve, φ = {phi:.2f}, σ_in = "
+                 f"{float(point['imposed_stress']):.3g} σ*", fontsize="medium")
+    return fig
+
+
+def plot_bands(data: xr.Dataset, phi: float, index: int) -> Figure:
+    """The f field of the final snapshot per non-locality (seed 002 Fig. 4 g–i) and the band
+    criterion against the imposed stress.
+
+    Top row: f(x, y) at ``phi`` and stress index ``index``, one square per particle (x periodic
+    over L_x, walls at y = 0 and 1), each panel with its own colour range, titled with the
+    correlation length ξ in lattice spacings Δx and the spread of f — from the band runs
+    (``band_*``, their own lattice) when ``data`` has them, else from the study's runs. Bottom:
+    ξ/Δx of every study run at ``phi`` against σ_in, one line per non-locality, the band runs'
+    ξ as stars, the unstable range σ_β < σ_in < σ_α shaded
+    (:func:`suspsim.stages.dst_gather.correlation_length`). No file I/O.
+    """
+    spacing = 1.0 / int(data.attrs["n_y"])
+    banded = "band_nonlocality" in data.coords
+    if banded:
+        names = [str(n) for n in data["band_nonlocality"].values]
+        lattice = (data.attrs["band_n_x"], data.attrs["band_n_y"])
+        band_spacing = 1.0 / int(lattice[1])
+        fields = [{key: data[f"band_{key}"].sel(band_nonlocality=name).values
+                   for key in ("particle_x", "particle_y", "particle_frictional_fraction",
+                               "correlation_length", "frictional_fraction_spread")}
+                  for name in names]
+        stress = float(data["band_stress"])
+    else:
+        names = [str(n) for n in data["nonlocality"].values]
+        lattice, band_spacing = (data.attrs["n_x"], data.attrs["n_y"]), spacing
+        point = data.sel(phi=phi).isel(stress_index=index)
+        fields = [{key: point[key].sel(nonlocality=name).values
+                   for key in ("particle_x", "particle_y", "particle_frictional_fraction",
+                               "correlation_length", "frictional_fraction_spread")}
+                  for name in names]
+        stress = float(point["imposed_stress"])
+    fig = Figure(figsize=(max(4.2 * len(names), 9.0), 7.6), layout="constrained")
+    grid = fig.add_gridspec(2, len(names), height_ratios=(1.3, 1))
+    for k, (name, field) in enumerate(zip(names, fields)):
+        ax = fig.add_subplot(grid[0, k])
+        dots = ax.scatter(field["particle_x"], field["particle_y"],
+                          c=field["particle_frictional_fraction"], cmap="viridis", marker="s",
+                          s=max(4.0, 2000.0 / field["particle_x"].size))
+        fig.colorbar(dots, ax=ax, label="f [1]", shrink=0.8)
+        ax.set_aspect("equal")
+        ax.set_ylim(0.0, 1.0)
+        ax.set_xlabel("x [L_y]")
+        ax.set_ylabel("y [L_y]")
+        alpha = float(data["alpha"].sel(nonlocality=name))
+        ax.set_title(f"{name} (α = {alpha:g}): ξ = "
+                     f"{float(field['correlation_length']) / band_spacing:.2f} Δx\n"
+                     f"std f = {float(field['frictional_fraction_spread']):.3f}",
+                     fontsize="medium")
+    lower = fig.add_subplot(grid[1, :])
+    curves = data.sel(phi=phi)
+    colours = {}
+    for name in data["nonlocality"].values:
+        curve = curves.sel(nonlocality=name)
+        line, = lower.plot(curve["imposed_stress"].values,
+                           curve["correlation_length"].values / spacing, "o-", ms=4,
+                           label=f"{name}, {data.attrs['n_x']} × {data.attrs['n_y']}")
+        colours[str(name)] = line.get_color()
+    if banded:
+        for name, field in zip(names, fields):
+            lower.plot(stress, float(field["correlation_length"]) / band_spacing, "*", ms=13,
+                       mec="k", color=colours.get(name, "k"),
+                       label=f"{name}, {lattice[0]} × {lattice[1]} (band run)")
+    sb, sa = float(data["sigma_beta"].sel(phi=phi)), float(data["sigma_alpha"].sel(phi=phi))
+    if np.isfinite(sb) and np.isfinite(sa):
+        lower.axvspan(sb, sa, color="0.9", label="unstable branch σ_β < σ_in < σ_α")
+    lower.axvline(stress, color="tab:red", ls=":", lw=1.0, label="the runs above")
+    lower.set_xscale("log")
+    lower.set_xlabel("imposed stress σ_in [σ*]")
+    lower.set_ylabel("correlation length ξ of f [Δx]")
+    lower.grid(True, alpha=0.3)
+    lower.legend(fontsize="x-small", ncol=2)
+    fig.suptitle(f"Microstructure f at φ = {phi:.2f}, σ_in = {stress:.3g} σ*, "
+                 f"{lattice[0]} × {lattice[1]} particles", fontsize="medium")
     return fig
