@@ -22,12 +22,12 @@ Newtonian case; Papanastasiou with seed 000's μ_0/μ_pl = 99, M = 100 τ and Bi
 Bn = μ_0/(M μ_pl γ̇). Error: |σ_xy/(μ(γ̇)γ̇) − 1| over whole strain units after one unit of
 transient (``validation.flows``).
 
-Poiseuille (SPEC §6.2, split force): width W = L_y/2 [h], lateral sides at least 3.75 h (3D)
-or 8 h (2D), rounded up to whole rows. Newtonian: ν = 1.25 h²/τ, u_max = g W²/(8ν) kept at its W = 5 h value (g = 0.01 h τ⁻²
-there), run 3 t_ν, t_ν = W²/ν, the last t_ν averaged. Bingham (Papanastasiou, μ_0/μ_pl = 99,
-M = 100, ν_pl = 20/4.096 h²/τ): the body force of the Bingham number (``reference.poiseuille``),
-started from the Newtonian profile of equal flow rate, run 0.8 t_pl and the last 0.2 t_pl
-averaged, t_pl = W²/ν_pl. Error: L2/peak of the averaged profile.
+Poiseuille (SPEC §6.2, split force): width W = L_y/2 [h], lateral sides at least 3.75 h (3D) or 8 h
+(2D), rounded up to whole rows. Newtonian: ν = 1.25 h²/τ, u_max = g W²/(8ν) kept at its W = 5 h
+value (g = 0.01 h τ⁻² there), run 3 t_ν, t_ν = W²/ν, the last t_ν averaged. Bingham (Papanastasiou,
+μ_0/μ_pl = 99, M = 100, ν_pl = 20/4.096 h²/τ): the body force of the Bingham number
+(``reference.poiseuille``), started from the Newtonian profile of equal flow rate, run 0.8 t_pl and
+the last 0.2 t_pl averaged, t_pl = W²/ν_pl. Error: L2/peak of the averaged profile.
 
 DST flow-curve point (SPEC §1.3, §5.4; :class:`DSTPointCase`): the 2D Wyart–Cates solver
 under stress control; error ⟨γ̇⟩/γ̇_WC − 1.
@@ -321,6 +321,7 @@ class DSTPointCase(_Settings):
         self._point(settings, threads, 0.01, 0.01)
 
     def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
+        """Run and read the point of ``settings`` (set-up and run are not timed apart)."""
         t0 = time.perf_counter()
         point = self._point(settings, threads, float(settings["equilibration_strain"]),
                             float(settings["averaging_strain"]))
@@ -348,15 +349,18 @@ def dst_flow_curve_point(phi: float = 0.54, stress: float = 2.5,
                         phi, stress, alpha)
 
 
+#: Any kind of case: an SPH fluid case or a DST flow-curve point.
+AnyCase = Case | DSTPointCase
+
 #: The registered cases by name.
-CASES: dict[str, Case] = {case.name: case for case in (
+CASES: dict[str, AnyCase] = {case.name: case for case in (
     newtonian_couette(3), newtonian_couette(2), papanastasiou_couette(9.9, 3),
     papanastasiou_couette(99.0, 3), newtonian_poiseuille(3), newtonian_poiseuille(2),
     bingham_poiseuille(1.0, 3), bingham_poiseuille(10.0, 3), dst_flow_curve_point(0.54, 2.5),
     dst_flow_curve_point(0.50, 1.0))}
 
 
-def get_case(name: str) -> Case:
+def get_case(name: str) -> AnyCase:
     """The registered case ``name``; an unknown name is an InputError listing them."""
     try:
         return CASES[name]

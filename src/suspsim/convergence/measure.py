@@ -1,11 +1,11 @@
 """Run one configuration of a validation case and record what its accuracy cost.
 
-The cost is the wall time a user pays for the number: building the simulation (lattice,
-neighbour list) and running it, on a fixed thread count, with numba's compiled code already
-loaded (a warm-up of the same scene runs two steps first, so compilation or cache loading is
-not counted). The CPU time is recorded beside it: on one thread it equals the wall time on an
-idle core and does not grow when other jobs share the machine. Particle-steps per second is
-N × steps / run time, the solver's throughput on this configuration.
+The cost is the wall time a user pays for the number: building the simulation (lattice, neighbour
+list) and running it, on a fixed thread count, with numba's compiled code already loaded (each
+case's warm-up first runs two steps of the same SPH scene, or 0.02 strain of the same DST point, so
+compilation or cache loading is not counted). The CPU time is recorded beside it: on one thread it
+equals the wall time on an idle core and does not grow when other jobs share the machine.
+Particle-steps per second is N × steps / run time, the solver's throughput on this configuration.
 """
 from __future__ import annotations
 
@@ -13,10 +13,12 @@ import logging
 import time
 from typing import Any, Mapping
 
+from suspsim.convergence.cases import AnyCase
 
 log = logging.getLogger(__name__)
 
-def run_configuration(case, overrides: Mapping[str, Any] | None = None, *,
+
+def run_configuration(case: AnyCase, overrides: Mapping[str, Any] | None = None, *,
                       threads: int = 1) -> dict[str, Any]:
     """Measure ``case`` (:mod:`.cases`) at its defaults updated by ``overrides`` on
     ``threads`` threads, after its warm-up.

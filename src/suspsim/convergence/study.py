@@ -20,7 +20,7 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from suspsim.convergence.cases import Case
+from suspsim.convergence.cases import AnyCase
 from suspsim.errors import InputError
 
 SWEEPS = ("one_at_a_time", "grid")
@@ -49,7 +49,7 @@ MEASURED = {
 }
 
 
-def configurations(case: Case, values: Mapping[str, Sequence[Any]],
+def configurations(case: AnyCase, values: Mapping[str, Sequence[Any]],
                    sweep: str = "one_at_a_time") -> list[dict[str, Any]]:
     """The overrides of each configuration (``{}`` is the case's defaults), without repeats."""
     if sweep not in SWEEPS:
@@ -84,7 +84,7 @@ def _tag(value) -> str:
     return f"{value:g}" if isinstance(value, (int, float)) else str(value)
 
 
-def case_dataset(case: Case, records: Iterable[Mapping[str, Any]]) -> xr.Dataset:
+def case_dataset(case: AnyCase, records: Iterable[Mapping[str, Any]]) -> xr.Dataset:
     """The records of one case on dimension ``configuration`` (named by :func:`configuration_id`
     of their overrides); a failed configuration has NaN measurements and its message in
     ``failure``. Units on every variable; the Pareto front as ``pareto`` (1 on the front)."""
@@ -154,7 +154,7 @@ def cost_table(datasets: Sequence[xr.Dataset], targets: Sequence[float] = TABLE_
             error = f"{float(row['error']):.2%}" + (f" ± {stderr:.2%}" if np.isfinite(stderr)
                                                    else "")
             lines.append(f"| {ds.attrs['case']} | {target * 100:g}% "
-                         f"| {row['configuration'].item()} | {error} | {float(row['cpu_time']):.3g} "
-                         f"| {int(row['n_particles'])} "
+                         f"| {row['configuration'].item()} | {error} "
+                         f"| {float(row['cpu_time']):.3g} | {int(row['n_particles'])} "
                          f"| {float(row['particle_steps_per_s']) / 1e6:.2f} |")
     return "\n".join(lines) + "\n"

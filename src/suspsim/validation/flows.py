@@ -47,9 +47,9 @@ def _require_health(sim) -> None:
 
 def couette_viscosity_ratio(sim, *, transient: float = 1.0, units: int = 3) -> Reading:
     """σ_xy/(μ(γ̇) γ̇) − 1 of a Couette ``sim`` (a fresh
-    :class:`~suspsim.sph.simulation.Simulation`) averaged over ``units`` whole strain units after ``transient`` strain units; ``stderr`` is
-    the standard deviation of the strain-unit means over √units. Raises NumericalError if the
-    run left its health limits."""
+    :class:`~suspsim.sph.simulation.Simulation`) averaged over ``units`` whole strain units
+    after ``transient`` strain units; ``stderr`` is the standard deviation of the strain-unit
+    means over √units. Raises NumericalError if the run left its health limits."""
     scene = sim.scene
     rate = scene.flow.shear_rate
     per_unit = max(1, int(round(1.0 / (rate * sim.dt))))
