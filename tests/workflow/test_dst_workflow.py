@@ -7,8 +7,6 @@ at phi = 0.54, 13 x 8), otherwise with 5 stresses and 14 x 10.
 import os
 import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,47 +15,16 @@ import xarray as xr
 import yaml
 
 from suspsim.stages.dst import band_points, study_points
+from test_snakemake import _dry_jobs, _jobs, _run, _study
 
 REPO = Path(__file__).resolve().parents[2]
-SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 REDUCED = os.environ.get("SUSPSIM_REDUCED") == "1"
 DST_RULES = {"simulate_dst_point", "simulate_dst_band", "gather_dst", "plot_dst"}
 
 
-def _study(tmp_path):
-    """A copy of the workflow (no data folder: the dst study needs none)."""
-    tmp_path.mkdir(parents=True, exist_ok=True)
-    for item in ("Snakefile", "workflow", "config"):
-        src = REPO / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
-    return tmp_path
-
-
-def _run(cwd, *args, cores="1"):
-    return subprocess.run([*SNAKEMAKE, "--cores", cores, *args], cwd=cwd, capture_output=True,
-                          text=True)
-
-
-def _jobs(proc):
-    """{rule: count} from the job-stats table of a (dry) run; empty when nothing is to be done."""
-    text = proc.stdout + proc.stderr
-    table = text.partition("Job stats:")[2].partition("\n\n")[0]
-    return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)$", table, re.MULTILINE)
-            if m[1] != "total"}
-
-
 def _wildcards(proc, rule):
-    """The wildcards of each job of ``rule`` in a dry run's listing, as tuples."""
-    found, current = [], None
-    for line in (proc.stdout + proc.stderr).splitlines():
-        header = re.match(r"^(?:local)?rule (\w+):$", line)
-        if header:
-            current = header[1]
-        elif current == rule and line.strip().startswith("wildcards: "):
-            items = dict(item.split("=") for item in
-                         line.strip().removeprefix("wildcards: ").split(", "))
-            found.append((items["phi"], items["nonlocality"], items["index"]))
-    return found
+    """(phi, nonlocality, index) of each job of ``rule`` in a dry run's listing."""
+    return [(job["phi"], job["nonlocality"], job["index"]) for job in _dry_jobs(proc, rule)]
 
 
 def _settings(study, name):
@@ -71,7 +38,7 @@ def _settings(study, name):
 
 
 def test_dst_study_lists_one_job_per_point_and_nothing_else(tmp_path):
-    study = _study(tmp_path)
+    study = _study(tmp_path, {})
     dry = _run(study, "-n", "--configfile", "config/studies/dst.yaml")
     assert dry.returncode == 0, dry.stderr
     settings = _settings(study, "dst")
@@ -91,7 +58,7 @@ def test_dst_study_lists_one_job_per_point_and_nothing_else(tmp_path):
 
 @pytest.mark.parametrize("configfile", [None, "config/studies/smoke.yaml"])
 def test_other_studies_list_no_dst_jobs(tmp_path, configfile):
-    study = _study(tmp_path)
+    study = _study(tmp_path, {})
     (study / "data/linear_polymer").mkdir(parents=True)
     shutil.copy(REPO / "data/linear_polymer/matrix.csv", study / "data/linear_polymer")
     (study / "data/carbopol_pg").mkdir(parents=True)
@@ -103,7 +70,7 @@ def test_other_studies_list_no_dst_jobs(tmp_path, configfile):
 
 
 def test_changing_one_volume_fraction_reruns_only_its_points(tmp_path):
-    study = _study(tmp_path)
+    study = _study(tmp_path, {})
     config = study / "config/studies/dst_smoke.yaml"
     config.write_text(config.read_text().replace("volume_fractions: [0.54]",
                                                  "volume_fractions: [0.50, 0.54]"))
@@ -125,7 +92,7 @@ def test_changing_one_volume_fraction_reruns_only_its_points(tmp_path):
 
 @pytest.mark.slow
 def test_reduced_dst_study_end_to_end_against_the_wyart_cates_curve(tmp_path):
-    study = _study(tmp_path)
+    study = _study(tmp_path, {})
     config = study / "config/studies/dst_smoke.yaml"
     if not REDUCED:
         config.write_text(config.read_text().replace("stress_count: 3", "stress_count: 5")

@@ -1,9 +1,6 @@
 """The speed_error study through Snakemake: the jobs it lists, a bad case stopping the
 workflow with the config key, and the smoke study end to end (records, case files, figure,
 table) then nothing to do."""
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,26 +8,13 @@ import pytest
 import xarray as xr
 import yaml
 
-from test_snakemake import _jobs
+from test_snakemake import _jobs, _run, _study
 
 REPO = Path(__file__).resolve().parents[2]
-SNAKEMAKE = [sys.executable, "-m", "snakemake"]
-
-
-def _copy(tmp_path):
-    for item in ("Snakefile", "workflow", "config", "data"):
-        src = REPO / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
-    return tmp_path
-
-
-def _run(cwd, *args, cores="2"):
-    return subprocess.run([*SNAKEMAKE, "--cores", cores, *args], cwd=cwd, capture_output=True,
-                          text=True)
 
 
 def test_study_lists_one_measure_per_configuration_and_no_material_jobs(tmp_path):
-    study = _copy(tmp_path)
+    study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
     proc = _run(study, "-n", "--configfile", "config/studies/speed_error.yaml")
     assert proc.returncode == 0, proc.stderr
     jobs = _jobs(proc)
@@ -41,11 +25,13 @@ def test_study_lists_one_measure_per_configuration_and_no_material_jobs(tmp_path
     assert jobs["speed_error_report"] == 1
     assert set(jobs) == {"speed_error_measure", "speed_error_gather", "speed_error_report", "all"}
     proc = _run(study, "-n", "--configfile", "config/studies/smoke.yaml")
+    assert proc.returncode == 0, proc.stderr
+    assert "simulate" in _jobs(proc)
     assert not any(rule.startswith("speed_error") for rule in _jobs(proc))
 
 
 def test_unknown_case_or_axis_stops_with_the_config_key(tmp_path):
-    study = _copy(tmp_path)
+    study = _study(tmp_path, {})
     bad = study / "bad.yaml"
     bad.write_text("material_study: false\nspeed_error: {cases: {couette_newtonian_3d: "
                    "{spacing: [1]}}}\n")
@@ -58,8 +44,8 @@ def test_unknown_case_or_axis_stops_with_the_config_key(tmp_path):
 
 @pytest.mark.slow
 def test_smoke_study_end_to_end(tmp_path):
-    study = _copy(tmp_path)
-    proc = _run(study, "--configfile", "config/studies/speed_error_smoke.yaml")
+    study = _study(tmp_path, {})
+    proc = _run(study, "--configfile", "config/studies/speed_error_smoke.yaml", cores="2")
     assert proc.returncode == 0, proc.stderr
     out = study / "results/speed_error"
     couette = xr.load_dataset(out / "couette_newtonian_3d.nc")
