@@ -26,9 +26,11 @@ def _profile():
 
 
 def _rules():
-    """Every rule of workflow/rules/ that runs a job (the Snakefile's `all` only collects)."""
+    """Every rule of workflow/rules/ that runs a job (the Snakefile's `all` only collects),
+    including those derived with `use rule ... as NAME`."""
     text = "".join(p.read_text() for p in sorted((REPO / "workflow/rules").glob("*.smk")))
-    return set(re.findall(r"^rule (\w+):", text, re.MULTILINE))
+    return set(re.findall(r"^rule (\w+):", text, re.MULTILINE)) | set(
+        re.findall(r"^use rule \w+ as (\w+)", text, re.MULTILINE))
 
 
 def test_profile_submits_to_slurm_polls_squeue_and_gives_every_rule_runtime_and_memory():
