@@ -4,7 +4,8 @@
                                             [--sets NAME ...]
     python docs/figures/make_dst_channel.py --plot-only   # redraw from the .nc
 
-A documented script until the workflow wiring lands. At φ = 0.54 runs
+The dst study's channel rules (``dst.channel`` in ``config/studies/dst.yaml``) run the same
+sets as one job per force; this script runs them in one process. At φ = 0.54 runs
 :func:`suspsim.dst.channel_study.channel_sweep` over ``--forces`` (F H/σ*, default 12 values
 0.5–200, denser between 1 and 10) for
 
@@ -27,19 +28,14 @@ atomically.
 """
 import argparse
 import logging
-import shlex
-import sys
 import time
-from datetime import datetime, timezone
 from pathlib import Path
-
-import xarray as xr
 
 from suspsim.dst.channel_study import channel_sweep
 from suspsim.dst.study import LOCAL, MODERATE_NONLOCALITY, SEED_002, STRONG_NONLOCALITY
-from suspsim.io.atomic import atomic_path, save_figure
-from suspsim.io.provenance import provenance
+from suspsim.io.atomic import save_figure
 from suspsim.plotting.dst_channel import plot_channel_flow, plot_channel_profiles
+from suspsim.stages.dst_channel_gather import read_groups, write_groups
 
 HERE = Path(__file__).resolve().parent
 NETCDF = HERE / "dst_channel.nc"
@@ -54,26 +50,6 @@ RUNS = {"seed-local": (SEED, LOCAL), "seed-strong": (SEED, STRONG_NONLOCALITY),
         "seed-moderate": (SEED, MODERATE_NONLOCALITY), "fig8-local": (FIG8, LOCAL),
         "fig8-strong": (FIG8, STRONG_NONLOCALITY)}
 DEFAULT_SETS = ("seed-local", "seed-strong", "seed-moderate", "fig8-local")
-
-
-def write_groups(path, datasets: dict, total_wall_time):
-    """One netCDF4 group per run set under a root group of global attributes."""
-    prov = provenance()
-    root = xr.Dataset(attrs={
-        "Conventions": "CF-1.10",
-        "title": f"2D SPH channel flow of a Wyart-Cates suspension at phi = {PHI}: local model "
-                 "and non-locality against the local ODE and the inverse-biviscous model",
-        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), "
-                  "docs/figures/make_dst_channel.py",
-        "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')}: "
-                   f"{shlex.join(sys.argv)}",
-        "groups": " ".join(datasets), "wall_time_s": total_wall_time, "completed": 1, **prov})
-    with atomic_path(path) as tmp:
-        root.to_netcdf(tmp, mode="w", engine="netcdf4")
-        for name, data in datasets.items():
-            data.to_netcdf(tmp, mode="a", group=name, engine="netcdf4",
-                           encoding={"force_ratio": {"_FillValue": None},
-                                     "y": {"_FillValue": None}})
 
 
 def _table(name, data):
@@ -114,9 +90,7 @@ def main() -> None:
                         help="redraw the figures and tables from the existing .nc, no runs")
     args = parser.parse_args()
     if args.plot_only:
-        with xr.open_dataset(NETCDF) as root:
-            groups = root.attrs["groups"].split()
-        datasets = {g: xr.load_dataset(NETCDF, group=g) for g in groups}
+        datasets = read_groups(NETCDF)
         for name, data in datasets.items():
             _table(name, data)
         _figures(datasets)
@@ -132,7 +106,7 @@ def main() -> None:
                                        **fractions)
         _table(name, datasets[name])
     total = time.perf_counter() - start
-    write_groups(NETCDF, datasets, total)
+    write_groups(NETCDF, datasets)
     _figures(datasets)
     runs = sum(d.sizes["force_ratio"] for d in datasets.values())
     print(f"\ntotal wall time {total:.0f} s ({runs} runs, threads {args.threads}); wrote "

@@ -5,7 +5,6 @@ Slow; ``SUSPSIM_REDUCED=1`` (CI) runs ``config/studies/dst_smoke.yaml`` as it is
 at phi = 0.54, 13 x 8), otherwise with 5 stresses and 14 x 10.
 """
 import os
-import re
 import shutil
 from pathlib import Path
 
@@ -15,11 +14,13 @@ import xarray as xr
 import yaml
 
 from suspsim.stages.dst import band_points, study_points
-from test_snakemake import _dry_jobs, _jobs, _run, _study
+from suspsim.stages.dst_channel import channel_jobs
+from test_snakemake import _dry_jobs, _jobs, _placeholders, _run, _study
 
 REPO = Path(__file__).resolve().parents[2]
 REDUCED = os.environ.get("SUSPSIM_REDUCED") == "1"
-DST_RULES = {"simulate_dst_point", "simulate_dst_band", "gather_dst", "plot_dst"}
+DST_RULES = {"simulate_dst_point", "simulate_dst_band", "gather_dst", "plot_dst",
+             "simulate_dst_channel", "gather_dst_channel", "plot_dst_channel"}
 
 
 def _wildcards(proc, rule):
@@ -46,8 +47,13 @@ def test_dst_study_lists_one_job_per_point_and_nothing_else(tmp_path):
     assert len(points) == 3 * 3 * 12
     bands = band_points(settings)
     assert [p.nonlocality.name for p in bands] == ["moderate", "zero"]
+    channel = channel_jobs(settings)
+    assert len(channel) == 4 * 12
     assert _jobs(dry) == {"simulate_dst_point": len(points), "simulate_dst_band": len(bands),
-                          "gather_dst": 1, "plot_dst": 1, "all": 1}
+                          "gather_dst": 1, "plot_dst": 1, "simulate_dst_channel": len(channel),
+                          "gather_dst_channel": 1, "plot_dst_channel": 1, "all": 1}
+    assert {(job["set"], job["index"]) for job in _dry_jobs(dry, "simulate_dst_channel")} == {
+        (job.name, f"{job.index:02d}") for job in channel}
     assert {(f"{p.phi:g}", p.nonlocality.name, f"{p.index:02d}") for p in bands} == set(
         _wildcards(dry, "simulate_dst_band"))
     wanted = {(f"{p.phi:g}", p.nonlocality.name, f"{p.index:02d}") for p in points}
@@ -75,12 +81,7 @@ def test_changing_one_volume_fraction_reruns_only_its_points(tmp_path):
     config.write_text(config.read_text().replace("volume_fractions: [0.54]",
                                                  "volume_fractions: [0.50, 0.54]"))
     args = ("--configfile", "config/studies/dst_smoke.yaml")
-    dry = _run(study, "-n", *args)
-    for line in re.findall(r"^\s+output: (.*)$", dry.stdout + dry.stderr, re.MULTILINE):
-        for name in line.split(", "):
-            (study / name).parent.mkdir(parents=True, exist_ok=True)
-            (study / name).touch()
-    assert _run(study, "--touch", "--forceall", *args).returncode == 0
+    _placeholders(study, *args)
     assert "Nothing to be done" in _run(study, "-n", *args).stdout
     config.write_text(config.read_text().replace("[0.50, 0.54]", "[0.52, 0.54]"))
     dry = _run(study, "-n", *args)
@@ -123,7 +124,14 @@ def test_reduced_dst_study_end_to_end_against_the_wyart_cates_curve(tmp_path):
         assert np.all(stable["frictional_fraction_spread"].values < 0.01)
         assert list(data["band_nonlocality"].values) == ["zero"]
         assert data["band_particle_x"].shape == (1, 13 * 10)
-    for name in ("flow_curves", "particles", "splitting", "bands"):
+    # the local channel against its ODE at the two smoke forces, on a 13 x 8 lattice (the
+    # validation's 2 % needs 14 x 20, tests/validation/test_dst_channel.py)
+    channel = xr.load_dataset(results / "channel.nc", group="local")
+    np.testing.assert_array_equal(channel["force_ratio"], [1.0, 10.0])
+    assert np.all(np.abs(channel["mean_velocity_error"].values) < 0.10)
+    assert np.all(channel["velocity_l2_error"].values < 0.06)
+    for name in ("flow_curves", "particles", "splitting", "bands", "channel_profiles",
+                 "channel_flow"):
         assert (results / f"{name}.png").stat().st_size > 10_000
     for rule in ("simulate_dst_point/phi-0.54_nonlocality-zero_stress-01", "gather_dst/gather_dst",
                  "plot_dst/plot_dst"):

@@ -1,15 +1,20 @@
 # The dst study (seed 002, issue 5): one stress-controlled DST run per volume fraction x
 # non-locality x imposed stress (suspsim.stages.dst), gathered into results/dst/flow_curves.nc,
-# and its figures. A channel rule (Fig. 7, 8) can sit beside these under results/dst/channel/.
+# and its figures; and the channel flows of Fig. 7-8, one run per set x driving force
+# (suspsim.stages.dst_channel), gathered into results/dst/channel.nc with their figures.
 from suspsim.stages.dst import band_points, find_point, point_scene, study_points
+from suspsim.stages.dst_channel import channel_jobs, find_channel_job
 
 
 DST = config["dst"]
 DST_DIR = RESULTS / "dst"
 DST_POINTS = study_points(DST)
 DST_BANDS = band_points(DST)
+DST_CHANNEL = channel_jobs(DST)
 CODE_DST = {
     "simulate": code_version("suspsim.stages.dst"),
+    "channel": code_version("suspsim.stages.dst_channel"),
+    "channel_gather": code_version("suspsim.stages.dst_channel_gather"),
     "gather": code_version("suspsim.stages.dst_gather"),
     "figures": code_version("suspsim.stages.dst_figures"),
 }
@@ -42,12 +47,30 @@ def dst_band_scene(wildcards):
                                        int(wildcards.index), band=True), band=True)
 
 
+def _channel_run(job):
+    return f"{DST_DIR}/channel/{job.name}_force-{job.index:02d}.nc"
+
+
+def dst_channel_files(wildcards):
+    """The channel run files, set by set in force order (what gather_dst_channel expects)."""
+    return [_channel_run(job) for job in DST_CHANNEL]
+
+
+def dst_channel_job(wildcards):
+    """One channel run's settings (a dict): a change re-runs it."""
+    job = find_channel_job(DST, wildcards.set, int(wildcards.index))
+    return {"force_ratio": job.force_ratio, **job.sweep}
+
+
 def dst_outputs():
-    """The study's final files; none without volume fractions."""
-    if not DST_POINTS:
-        return []
-    return [str(DST_DIR / name) for name in ("flow_curves.nc", "flow_curves.png",
-                                             "particles.png", "splitting.png", "bands.png")]
+    """The study's final files; none without volume fractions or channel sets."""
+    names = []
+    if DST_POINTS:
+        names += ["flow_curves.nc", "flow_curves.png", "particles.png", "splitting.png",
+                  "bands.png"]
+    if DST_CHANNEL:
+        names += ["channel.nc", "channel_profiles.png", "channel_flow.png"]
+    return [str(DST_DIR / name) for name in names]
 
 
 STUDY_OUTPUTS.append(dst_outputs)
@@ -134,3 +157,62 @@ rule plot_dst:
         code=CODE_DST["figures"],
     script:
         "../scripts/plot_dst.py"
+
+
+rule simulate_dst_channel:
+    output:
+        run=f"{DST_DIR}/channel/{{set}}_force-{{index}}.nc",
+    log:
+        "logs/simulate_dst_channel/{set}_force-{index}.log",
+    benchmark:
+        "logs/benchmarks/simulate_dst_channel/{set}_force-{index}.tsv"
+    wildcard_constraints:
+        set=r"[A-Za-z0-9-]+",
+        index=r"[0-9]+",
+    threads: DST["threads"]
+    params:
+        job=dst_channel_job,
+        code=CODE_DST["channel"],
+    script:
+        "../scripts/simulate_dst_channel.py"
+
+
+rule gather_dst_channel:
+    input:
+        runs=dst_channel_files,
+    output:
+        channel=f"{DST_DIR}/channel.nc",
+    log:
+        "logs/gather_dst_channel/gather_dst_channel.log",
+    benchmark:
+        "logs/benchmarks/gather_dst_channel/gather_dst_channel.tsv"
+    params:
+        sets=[job.name for job in DST_CHANNEL],
+        code=CODE_DST["channel_gather"],
+    script:
+        "../scripts/gather_dst_channel.py"
+
+
+rule plot_dst_channel:
+    input:
+        channel=f"{DST_DIR}/channel.nc",
+    output:
+        profiles=report(
+            f"{DST_DIR}/channel_profiles.png",
+            caption="../report/dst_channel_profiles.rst",
+            category="Discontinuous shear thickening",
+        ),
+        flow=report(
+            f"{DST_DIR}/channel_flow.png",
+            caption="../report/dst_channel_flow.rst",
+            category="Discontinuous shear thickening",
+        ),
+    log:
+        "logs/plot_dst_channel/plot_dst_channel.log",
+    benchmark:
+        "logs/benchmarks/plot_dst_channel/plot_dst_channel.tsv"
+    params:
+        profile_forces=DST.get("channel", {}).get("profile_forces", []),
+        code=CODE_DST["channel_gather"],
+    script:
+        "../scripts/plot_dst_channel.py"

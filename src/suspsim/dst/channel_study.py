@@ -35,22 +35,17 @@ Two protocols (``protocol``; default ``"momentum"`` for α = 0, ``"relaxed"`` fo
 """
 from __future__ import annotations
 
-import json
 import logging
 import math
-import shlex
-import sys
 import time as wallclock
-from datetime import datetime, timezone
 
 import numpy as np
 import xarray as xr
 
 from suspsim.dst.parameters import Channel, Geometry, Numerics, WyartCatesFluid
 from suspsim.dst.simulation import DSTSimulation
-from suspsim.dst.study import LOCAL, REFERENCES, SEED_002, UNIT_SYSTEM, _attrs
+from suspsim.dst.study import LOCAL, SEED_002, _attrs, study_attributes
 from suspsim.errors import InputError
-from suspsim.io.provenance import provenance
 from suspsim.reference.dst_channel import (dst_channel_fraction, dst_channel_mean_velocity,
                                            dst_channel_profile)
 from suspsim.reference.inverse_biviscous import InverseBiviscous
@@ -242,7 +237,7 @@ def channel_dataset(fluid: WyartCatesFluid, geometry: Geometry, force_ratios, re
     the rows ``y``, the same in every record) and ``n_particles``; the reference variables
     are computed here from ``fluid`` (local ODE) and the inverse-biviscous model with
     ``critical_rate`` (default front-selected). ``settings`` holds the protocol and its
-    parameters. Global attributes as :func:`suspsim.dst.study.flow_curve_dataset`, plus the
+    parameters. Global attributes: :func:`suspsim.dst.study.study_attributes`, plus the
     inverse-biviscous ``critical_rate``, ``low_viscosity``, ``high_viscosity``,
     ``lower_stress`` and ``upper_stress``.
     """
@@ -283,43 +278,18 @@ def channel_dataset(fluid: WyartCatesFluid, geometry: Geometry, force_ratios, re
     dataset = xr.Dataset(data, coords={
         "force_ratio": ("force_ratio", ratios, _attrs_of("force_ratio")),
         "y": ("y", y, _attrs_of("y"))})
-    turning = law.turning_points()
-    points = {"sigma_beta": math.nan, "gdot_max": math.nan, "sigma_alpha": math.nan,
-              "gdot_min": math.nan}
-    if turning is not None:
-        points = {k: float(v) for k, v in turning._asdict().items()}
-    parameters = {
-        "eta_s": fluid.eta_s, "phi": fluid.phi, "phi_m": fluid.phi_m, "phi_0": fluid.phi_0,
-        "sigma_star": fluid.sigma_star, "beta": fluid.beta, "K_f": fluid.K_f,
-        "alpha": fluid.alpha, "n_x": geometry.n_x, "n_y": geometry.n_y, "gap": gap,
-        "smoothing_ratio": geometry.smoothing_ratio, "wall_layers": geometry.wall_layers,
-        **settings}
     biviscous = {"critical_rate": model.critical_rate, "low_viscosity": model.low_viscosity,
                  "high_viscosity": model.high_viscosity, "lower_stress": model.lower_stress,
                  "upper_stress": model.upper_stress}
-    units = {"eta_s": "eta_s", "sigma_star": "sigma_star", "alpha": "L_y2 sigma_star eta_s-1",
-             "gap": "L_y", "sigma_beta": "sigma_star", "sigma_alpha": "sigma_star",
-             "gdot_max": "sigma_star eta_s-1", "gdot_min": "sigma_star eta_s-1",
-             "critical_rate": "sigma_star eta_s-1", "low_viscosity": "eta_s",
+    units = {"critical_rate": "sigma_star eta_s-1", "low_viscosity": "eta_s",
              "high_viscosity": "eta_s", "lower_stress": "sigma_star",
              "upper_stress": "sigma_star", "density": "sigma_star L_y2 eta_s-2"}
-    prov = provenance()
-    wall = float(np.nansum([r.get("wall_time", math.nan) for r in records]))
-    when = datetime.now(timezone.utc).isoformat(timespec="seconds")
-    command = shlex.join(sys.argv) if command is None else command
-    dataset.attrs = {
-        "Conventions": "CF-1.10",
-        "title": f"2D SPH channel flow of a Wyart-Cates suspension, phi = {fluid.phi:g}, "
-                 f"alpha = {fluid.alpha:g}",
-        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), "
-                  "suspsim.dst.channel_study.channel_sweep",
-        "history": f"{when}: {command}", "references": REFERENCES, "unit_system": UNIT_SYSTEM,
-        **parameters, "regime": law.regime(), **points, **biviscous,
-        "parameter_units": json.dumps(units),
-        "configuration": json.dumps({**parameters, **biviscous,
-                                     "force_ratios": ratios.tolist()}),
-        "n_particles": int(records[0].get("n_particles", 0)) if records else 0,
-        "wall_time_s": wall, "completed": 1, **prov}
+    dataset.attrs = study_attributes(
+        fluid, geometry, records, settings, command=command,
+        title=f"2D SPH channel flow of a Wyart-Cates suspension, phi = {fluid.phi:g}, "
+              f"alpha = {fluid.alpha:g}",
+        source="suspsim.dst.channel_study.channel_sweep", extra=biviscous, extra_units=units,
+        configuration={"force_ratios": ratios.tolist()})
     return dataset
 
 

@@ -197,10 +197,7 @@ def flow_curve_dataset(fluid: WyartCatesFluid, geometry: Geometry, stresses, rec
 
     Each record holds the measured variables of :data:`FLOW_CURVE_VARIABLES` (the steady-law
     ones are computed here from ``fluid``) and ``n_particles``; ``settings`` holds epsilon,
-    the strains, samples, n_blocks and threads. Global attributes: CF ``Conventions``,
-    ``title``, ``source``, ``history``, ``references``, ``unit_system``, every fluid, geometry
-    and study parameter, the turning points (NaN without), ``configuration`` (all of them as
-    JSON), ``wall_time_s``, ``completed`` and the provenance.
+    the strains, samples, n_blocks and threads. Global attributes: :func:`study_attributes`.
     """
     stresses = np.asarray(stresses, dtype=float)
     if len(records) != stresses.size:
@@ -219,7 +216,32 @@ def flow_curve_dataset(fluid: WyartCatesFluid, geometry: Geometry, stresses, rec
             values = values.astype(np.int64)
         data[name] = ("stress", values, _attrs(name))
     dataset = xr.Dataset(data, coords={"stress": ("stress", stresses, _attrs("stress"))})
-    turning = law.turning_points()
+    dataset.attrs = study_attributes(
+        fluid, geometry, records, settings, command=command,
+        title=f"Stress-controlled 2D SPH flow curve of a Wyart-Cates suspension, "
+              f"phi = {fluid.phi:g}, alpha = {fluid.alpha:g}",
+        source="suspsim.dst.study.flow_curve",
+        configuration={"stresses": stresses.tolist()})
+    return dataset
+
+
+def study_attributes(fluid: WyartCatesFluid, geometry: Geometry, records, settings: dict, *,
+                     title: str, source: str, command: str | None = None,
+                     extra: dict | None = None, extra_units: dict | None = None,
+                     configuration: dict | None = None) -> dict:
+    """Global attributes of a DST study Dataset (flow curve, channel sweep).
+
+    CF ``Conventions``, ``title``, ``source`` (version, git sha and the producing function
+    ``source``), ``history`` (time and ``command``, default the process's argv),
+    ``references``, ``unit_system``, every fluid, geometry and ``settings`` parameter, the
+    steady law's ``regime`` and turning points (NaN without), the study's ``extra`` scalars,
+    ``parameter_units`` (JSON; scaled units of the dimensional parameters, completed by
+    ``extra_units``), ``configuration`` (all parameters, ``extra`` and ``configuration`` as
+    JSON), ``n_particles`` of the first record, ``wall_time_s`` (sum over the records [s]),
+    ``completed`` and the provenance.
+    """
+    law = fluid.steady_law()
+    extra = extra or {}
     parameters = {
         "eta_s": fluid.eta_s, "phi": fluid.phi, "phi_m": fluid.phi_m, "phi_0": fluid.phi_0,
         "sigma_star": fluid.sigma_star, "beta": fluid.beta, "K_f": fluid.K_f,
@@ -228,28 +250,25 @@ def flow_curve_dataset(fluid: WyartCatesFluid, geometry: Geometry, stresses, rec
         **settings}
     units = {"eta_s": "eta_s", "sigma_star": "sigma_star", "alpha": "L_y2 sigma_star eta_s-1",
              "gap": "L_y", "sigma_beta": _STRESS, "sigma_alpha": _STRESS, "gdot_max": _RATE,
-             "gdot_min": _RATE}
+             "gdot_min": _RATE, **(extra_units or {})}
     points = {"sigma_beta": math.nan, "gdot_max": math.nan, "sigma_alpha": math.nan,
               "gdot_min": math.nan}
+    turning = law.turning_points()
     if turning is not None:
         points = {k: float(v) for k, v in turning._asdict().items()}
     prov = provenance()
     wall = float(np.nansum([r.get("wall_time", math.nan) for r in records]))
     when = datetime.now(timezone.utc).isoformat(timespec="seconds")
     command = shlex.join(sys.argv) if command is None else command
-    dataset.attrs = {
-        "Conventions": "CF-1.10",
-        "title": f"Stress-controlled 2D SPH flow curve of a Wyart-Cates suspension, "
-                 f"phi = {fluid.phi:g}, alpha = {fluid.alpha:g}",
-        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), "
-                  "suspsim.dst.study.flow_curve",
+    return {
+        "Conventions": "CF-1.10", "title": title,
+        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), {source}",
         "history": f"{when}: {command}", "references": REFERENCES, "unit_system": UNIT_SYSTEM,
-        **parameters, "regime": law.regime(), **points,
+        **parameters, "regime": law.regime(), **points, **extra,
         "parameter_units": json.dumps(units),
-        "configuration": json.dumps({**parameters, "stresses": stresses.tolist()}),
+        "configuration": json.dumps({**parameters, **extra, **(configuration or {})}),
         "n_particles": int(records[0].get("n_particles", 0)) if records else 0,
         "wall_time_s": wall, "completed": 1, **prov}
-    return dataset
 
 
 def _attrs(name: str, table: dict | None = None) -> dict[str, str]:
@@ -374,8 +393,8 @@ def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
     ψ1(t) − lever(V_w(t)/L_y), whose batch-means error is the statistical error of the
     comparison (fluctuations of V_w move both).
 
-    Returns a Dataset on ``stress`` (variables :data:`SPLITTING_VARIABLES`, attributes as
-    :func:`flow_curve_dataset`). Raises InputError for stresses outside (σ_β, σ_α) or a law
+    Returns a Dataset on ``stress`` (variables :data:`SPLITTING_VARIABLES`, attributes
+    :func:`study_attributes`). Raises InputError for stresses outside (σ_β, σ_α) or a law
     without turning points.
     """
     stresses = np.atleast_1d(np.asarray(stresses, dtype=float))
@@ -411,14 +430,12 @@ def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
         data[name] = ("stress", values, _attrs(name, SPLITTING_VARIABLES))
     dataset = xr.Dataset(data, coords={"stress": ("stress", stresses,
                                                   _attrs("stress", SPLITTING_VARIABLES))})
-    base = flow_curve_dataset(fluid, geometry, stresses, [{"steps": 0} for _ in stresses],
-                              settings)
-    dataset.attrs = {**base.attrs,
-                     "title": f"Stress splitting of the local Wyart-Cates model in 2D SPH "
-                              f"stress-controlled shear, phi = {phi:g}, alpha = {alpha:g}",
-                     "source": base.attrs["source"].replace("flow_curve", "stress_splitting"),
-                     "n_particles": int(records[0]["n_particles"]),
-                     "wall_time_s": float(sum(r["wall_time"] for r in records))}
+    dataset.attrs = study_attributes(
+        fluid, geometry, records, settings,
+        title=f"Stress splitting of the local Wyart-Cates model in 2D SPH stress-controlled "
+              f"shear, phi = {phi:g}, alpha = {alpha:g}",
+        source="suspsim.dst.study.stress_splitting",
+        configuration={"stresses": np.asarray(stresses, dtype=float).tolist()})
     return dataset
 
 

@@ -7,6 +7,7 @@ when that code changes (an editable install changes no version number).
 from __future__ import annotations
 
 import ast
+import functools
 import hashlib
 import platform
 import re
@@ -109,9 +110,16 @@ def _parents(name: str) -> list[str]:
 
 def _imported_modules(name: str, path: Path) -> list[str]:
     """Modules of this package that the source of ``name`` imports anywhere in its body."""
+    return list(_imports_of_source(name, path, path.read_bytes()))
+
+
+@functools.lru_cache(maxsize=None)
+def _imports_of_source(name: str, path: Path, source: bytes) -> tuple[str, ...]:
+    """:func:`_imported_modules` of one version of the source, parsed once per process (a
+    workflow asks for the fingerprint of a dozen stages that share most of their imports)."""
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found = []
-    for node in ast.walk(ast.parse(path.read_bytes(), filename=str(path))):
+    for node in ast.walk(ast.parse(source, filename=str(path))):
         if isinstance(node, ast.Import):
             found.extend(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -123,5 +131,5 @@ def _imported_modules(name: str, path: Path) -> list[str]:
             found.append(target)
             # "from pkg import sub" imports the module pkg.sub when there is one.
             found.extend(f"{target}.{alias.name}" for alias in node.names)
-    return [m for m in found if (m == _PACKAGE or m.startswith(_PACKAGE + "."))
-            and _module_file(m) is not None]
+    return tuple(m for m in found if (m == _PACKAGE or m.startswith(_PACKAGE + "."))
+                 and _module_file(m) is not None)

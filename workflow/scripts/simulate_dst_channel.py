@@ -1,0 +1,19 @@
+"""Snakemake shim for rule simulate_dst_channel: calls
+suspsim.stages.dst_channel.simulate_channel_point."""
+import logging
+import os
+import sys
+
+# Set before numba is first imported, so its thread pool is exactly the job's threads.
+os.environ["NUMBA_NUM_THREADS"] = str(snakemake.threads)
+
+from suspsim.errors import SuspsimError  # noqa: E402
+from suspsim.stages.dst_channel import simulate_channel_point  # noqa: E402
+
+logging.basicConfig(filename=snakemake.log[0], filemode="w", level=logging.INFO,
+                    format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+try:
+    simulate_channel_point(snakemake.params.job, snakemake.output.run, threads=snakemake.threads)
+except SuspsimError as err:
+    logging.getLogger("suspsim").error("%s", err)
+    sys.exit(f"simulate_dst_channel: {err}")
