@@ -192,7 +192,7 @@ def test_resume_continues_bit_for_bit(tmp_path):
 
 
 BAD_SCENES = [
-    ("dimension: 2", "dimension: 3", "[key 'dimension']", "2-D only"),
+    ("dimension: 2", "dimension: 3", "[key 'box']", "needs 3 box lengths"),
     ("type: stress_couette", "type: couette, shear_rate: 1", "[key 'flow.type']", "between walls"),
     ("law: wyart_cates", "law: newtonian", "[key 'fluid.law']", "needs law wyart_cates"),
     ("K_f: 1.0", "K: 1.0", "[key 'fluid.params.K']", "unknown key"),
