@@ -52,7 +52,8 @@ WALL_VELOCITY, WALL_ACCELERATION = 0, 1
 #: Everything constant during a run (ints, floats, bools; passed to the compiled loop as one);
 #: ``lz`` is the periodic length along z (3D; unused in 2D).
 Config = namedtuple("Config", [
-    "dimension", "n_fluid", "n_bottom", "lx", "lz", "y_lo", "y_hi", "cutoff", "skin", "h_sl", "rho0", "c", "p_b",
+    "dimension", "n_fluid", "n_bottom", "lx", "lz", "y_lo", "y_hi", "cutoff", "skin", "h_sl",
+    "rho0", "c", "p_b",
     "mass", "g_x", "stress_control", "stress", "area", "wall_mass",
     "eta_s", "phi", "phi_m", "phi_0", "sigma_star", "beta", "K_f", "alpha",
     "courant", "viscous_number", "force_number", "diffusion_number",
@@ -314,4 +315,5 @@ def allocate_lists(n_particles: int, capacity: int, dimension: int = 2) -> ListA
     return ListArrays(start=np.zeros(n + 1, dtype=np.int64),
                       neighbours=np.zeros(int(capacity), dtype=np.int64),
                       cell_of=np.zeros(n, dtype=np.int64), order=np.zeros(n, dtype=np.int64),
-                      reference=np.zeros((n, int(dimension))), force_rebuild=np.ones(1, dtype=np.int64))
+                      reference=np.zeros((n, int(dimension))),
+                      force_rebuild=np.ones(1, dtype=np.int64))

@@ -158,12 +158,12 @@ class DSTSimulation:
                                  f"3 list cells of {cutoff:g}; raise geometry.{name}", key=name)
         self.config = _int.Config(
             dimension=d, n_fluid=self.n_fluid, n_bottom=self.n_wall, lx=lx, lz=lz,
-            y_lo=-(layers + 1) * dx,
-            y_hi=ly + (layers + 1) * dx, cutoff=cutoff, skin=skin, h_sl=h_sl, rho0=rho0, c=c,
-            p_b=num.background_pressure, mass=mass, g_x=g_x, stress_control=couette,
-            stress=stress, area=lx if d == 2 else lx * lz, wall_mass=wall_mass, eta_s=fluid.eta_s, phi=fluid.phi,
-            phi_m=fluid.phi_m, phi_0=fluid.phi_0, sigma_star=fluid.sigma_star, beta=fluid.beta,
-            K_f=fluid.K_f, alpha=fluid.alpha, courant=num.courant,
+            y_lo=-(layers + 1) * dx, y_hi=ly + (layers + 1) * dx, cutoff=cutoff, skin=skin,
+            h_sl=h_sl, rho0=rho0, c=c, p_b=num.background_pressure, mass=mass, g_x=g_x,
+            stress_control=couette, stress=stress, area=lx if d == 2 else lx * lz,
+            wall_mass=wall_mass, eta_s=fluid.eta_s, phi=fluid.phi, phi_m=fluid.phi_m,
+            phi_0=fluid.phi_0, sigma_star=fluid.sigma_star, beta=fluid.beta, K_f=fluid.K_f,
+            alpha=fluid.alpha, courant=num.courant,
             viscous_number=num.viscous_number, force_number=num.force_number,
             diffusion_number=num.diffusion_number, shifting=num.shifting,
             shifting_coefficient=num.shifting_coefficient,

@@ -1,4 +1,5 @@
-"""Physics terms of the DST solver (2D and 3D): one small ``@njit`` function per equation (SPEC §5.1, §1.3).
+"""Physics terms of the DST solver (2D and 3D): one small ``@njit`` function per equation
+(SPEC §5.1, §1.3).
 
 Pair terms take the pair geometry (x_ij = x_i − x_j, r² and F = −W'(r)/r of the quintic spline,
 so ∇_iW_ij = −x_ij F) and return the contribution to particle i; pair loops live in

@@ -87,6 +87,12 @@ def test_shipped_examples_are_valid(name):
     assert isinstance(scene, DSTScene) and scene.geometry.n_y == 20
 
 
+def test_shipped_3d_example_is_valid():
+    scene = load_any_scene(ROOT / "config" / "scenes" / "dst_stress_couette_3d.yaml")
+    geo = scene.geometry
+    assert scene.dimension == 3 and (geo.n_x, geo.n_y, geo.n_z) == (13, 8, 13)
+
+
 def test_three_dimensional_scene_sets_the_z_lattice():
     scene = dst_scene_from_dict(dict(MINIMAL, dimension=3, box=[1.0, 1.0, 0.75]))
     geo = scene.geometry
