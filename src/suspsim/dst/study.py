@@ -423,8 +423,9 @@ def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
     base = flow_curve_dataset(fluid, geometry, stresses, [{"steps": 0} for _ in stresses],
                               settings)
     dataset.attrs = {**base.attrs,
-                     "title": f"Stress splitting of the local Wyart-Cates model in 2D SPH "
-                              f"stress-controlled shear, phi = {phi:g}, alpha = {alpha:g}",
+                     "title": f"Stress splitting of the local Wyart-Cates model in "
+                              f"{geometry.dimension}D SPH stress-controlled shear, "
+                              f"phi = {phi:g}, alpha = {alpha:g}",
                      "source": base.attrs["source"].replace("flow_curve", "stress_splitting"),
                      "n_particles": int(records[0]["n_particles"]),
                      "wall_time_s": float(sum(r["wall_time"] for r in records))}
