@@ -23,7 +23,9 @@ Symbols as in :mod:`~suspsim.dst.terms`; W, F the quintic spline of the run's di
 smoothing length h_sl (support 3 h_sl), g the body acceleration along x, a_w the wall
 acceleration along x. Each pass has a 2D and a 3D form (``*_3d``: z periodic, a third velocity
 component, the 3 × 3 gradient and moment matrix); the equations are the same, and the 2D pair
-loop carries no z terms.
+loop carries no z terms. The dimension enters only through the kernel's normalisation:
+7/(478π h_sl²) in 2D and 1/(120π h_sl³) in 3D (:mod:`suspsim.sph.kernels`; the exact integral,
+where Morris et al. 1997 print 3/(359π), 0.3 % larger).
 """
 from __future__ import annotations
 
