@@ -286,8 +286,8 @@ def channel_dataset(fluid: WyartCatesFluid, geometry: Geometry, force_ratios, re
              "upper_stress": "sigma_star", "density": "sigma_star L_y2 eta_s-2"}
     dataset.attrs = study_attributes(
         fluid, geometry, records, settings, command=command,
-        title=f"2D SPH channel flow of a Wyart-Cates suspension, phi = {fluid.phi:g}, "
-              f"alpha = {fluid.alpha:g}",
+        title=f"{geometry.dimension}D SPH channel flow of a Wyart-Cates suspension, "
+              f"phi = {fluid.phi:g}, alpha = {fluid.alpha:g}",
         source="suspsim.dst.channel_study.channel_sweep", extra=biviscous, extra_units=units,
         configuration={"force_ratios": ratios.tolist()})
     return dataset

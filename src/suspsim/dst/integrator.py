@@ -1,4 +1,4 @@
-"""Compiled step loop of the 2D DST solver: rate evaluation, step size, predictor–corrector.
+"""Compiled step loop of the DST solver (2D and 3D): rates, step size, predictor–corrector.
 
 Rates (:func:`evaluate`), in this order, at a state (x, v, ρ, f, V_w):
 
@@ -10,7 +10,7 @@ Rates (:func:`evaluate`), in this order, at a state (x, v, ρ, f, V_w):
 4. γ̇_i = sqrt(2 D:D), σ_i = η_i γ̇_i, Df_i/Dt = K_f γ̇_i (f̂(σ_i) − f_i) + α ∇²f_i;
 5. stress control (SPEC §5.4): dV_w/dt = (σ_in A_w − F_r)/M_w with F_r = Σ_i m a_top,i the
    viscous drag of the fluid on the top wall (a_top,i the x-acceleration of i by the top-wall
-   particles; the reaction is −m a_top,i), A_w = L_x.
+   particles; the reaction is −m a_top,i), A_w = L_x (per unit depth in 2D; L_x L_z in 3D).
 
 Step (:func:`advance_steps`, SPEC §5.2): δt = min(C_c h_sl/c, C_ν ρ0 h_sl²/η_max,
 C_a sqrt(h_sl/a_max), C_α h_sl²/α) (Morris et al. 1997 with the quintic smoothing length; the
@@ -23,6 +23,10 @@ to first order (v_i += G_i δx_i, f_i += ∇f_i·δx_i), using the gradients of 
 (SPEC §5.5 writes an extra δt; Lind's D = A h |v| δt already makes δx a length.)
 
 Blow-up checks after every step return an error code (Python raises NumericalError).
+
+The dimension d (``Config.dimension``, 2 or 3; positions are (N, d)) picks the 2D or 3D
+neighbour list and pair passes and the γ̇ of a d × d gradient; the per-particle loops run over
+d components. No criterion above carries a factor of d (the kernel normalisation does).
 """
 from __future__ import annotations
 
@@ -32,10 +36,11 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from suspsim.dst.neighbours import OK, build_list, needs_rebuild
-from suspsim.dst.passes import fluid_pass, wall_pass
-from suspsim.dst.terms import (microstructure_rate, shear_rate_2d, suspension_viscosity,
-                               tait_pressure)
+from suspsim.dst.neighbours import (OK, build_list, build_list_3d, needs_rebuild,
+                                    needs_rebuild_3d)
+from suspsim.dst.passes import fluid_pass, fluid_pass_3d, wall_pass, wall_pass_3d
+from suspsim.dst.terms import (microstructure_rate, shear_rate_2d, shear_rate_3d,
+                               suspension_viscosity, tait_pressure)
 from suspsim.sph import JIT_OPTIONS
 
 #: Codes returned by the compiled loop.
@@ -44,9 +49,11 @@ STEP_OK, NONFINITE, DENSITY_ERROR, MACH_LIMIT, JAMMED, LIST_OVERFLOW, NEAR_JAMMI
 #: Indices of the wall-state array: top-wall velocity V_w and its acceleration dV_w/dt.
 WALL_VELOCITY, WALL_ACCELERATION = 0, 1
 
-#: Everything constant during a run (ints, floats, bools; passed to the compiled loop as one).
+#: Everything constant during a run (ints, floats, bools; passed to the compiled loop as one);
+#: ``lz`` is the periodic length along z (3D; unused in 2D).
 Config = namedtuple("Config", [
-    "n_fluid", "n_bottom", "lx", "y_lo", "y_hi", "cutoff", "skin", "h_sl", "rho0", "c", "p_b",
+    "dimension", "n_fluid", "n_bottom", "lx", "lz", "y_lo", "y_hi", "cutoff", "skin", "h_sl",
+    "rho0", "c", "p_b",
     "mass", "g_x", "stress_control", "stress", "area", "wall_mass",
     "eta_s", "phi", "phi_m", "phi_0", "sigma_star", "beta", "K_f", "alpha",
     "courant", "viscous_number", "force_number", "diffusion_number",
@@ -66,11 +73,18 @@ ListArrays = namedtuple("ListArrays", ["start", "neighbours", "cell_of", "order"
 @njit(**JIT_OPTIONS)
 def refresh_list(cfg, positions, lists):
     """Rebuild the list when needed (or forced); returns STEP_OK or LIST_OVERFLOW."""
-    if lists.force_rebuild[0] == 0 and not needs_rebuild(positions, lists.reference, cfg.lx,
-                                                          cfg.skin):
-        return STEP_OK
-    code, _ = build_list(positions, cfg.lx, cfg.y_lo, cfg.y_hi, cfg.cutoff, lists.start,
-                         lists.neighbours, lists.cell_of, lists.order)
+    if cfg.dimension == 3:
+        if lists.force_rebuild[0] == 0 and not needs_rebuild_3d(
+                positions, lists.reference, cfg.lx, cfg.lz, cfg.skin):
+            return STEP_OK
+        code, _ = build_list_3d(positions, cfg.lx, cfg.lz, cfg.y_lo, cfg.y_hi, cfg.cutoff,
+                                lists.start, lists.neighbours, lists.cell_of, lists.order)
+    else:
+        if lists.force_rebuild[0] == 0 and not needs_rebuild(positions, lists.reference,
+                                                              cfg.lx, cfg.skin):
+            return STEP_OK
+        code, _ = build_list(positions, cfg.lx, cfg.y_lo, cfg.y_hi, cfg.cutoff, lists.start,
+                             lists.neighbours, lists.cell_of, lists.order)
     if code != OK:
         lists.force_rebuild[0] = 1
         return LIST_OVERFLOW
@@ -92,20 +106,29 @@ def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
             return JAMMED
         buf.eta[i] = eta
         buf.pressure[i] = tait_pressure(rho[i], cfg.rho0, cfg.c, cfg.p_b)
-        buf.v_visc[i, 0] = velocity[i, 0]
-        buf.v_visc[i, 1] = velocity[i, 1]
+        for a in range(cfg.dimension):
+            buf.v_visc[i, a] = velocity[i, a]
     v_wall = wall[WALL_VELOCITY]
-    wall_pass(nf, cfg.n_bottom, positions, velocity, rho, buf.pressure, buf.v_visc,
-              lists.start, lists.neighbours, cfg.lx, cfg.h_sl, cfg.rho0, cfg.c, cfg.p_b,
-              cfg.g_x, v_wall, wall[WALL_ACCELERATION])
-    fluid_pass(nf, cfg.n_bottom, positions, velocity, buf.v_visc, rho, buf.pressure, buf.eta, f,
-               cfg.mass, lists.start, lists.neighbours, cfg.lx, cfg.h_sl, cfg.g_x, v_wall,
-               cfg.gradient_correction, buf.drho, buf.acc, buf.acc_top, buf.grad, buf.grad_c,
-               buf.lap_f, buf.grad_f)
+    if cfg.dimension == 3:
+        wall_pass_3d(nf, cfg.n_bottom, positions, velocity, rho, buf.pressure, buf.v_visc,
+                     lists.start, lists.neighbours, cfg.lx, cfg.lz, cfg.h_sl, cfg.rho0, cfg.c,
+                     cfg.p_b, cfg.g_x, v_wall, wall[WALL_ACCELERATION])
+        fluid_pass_3d(nf, cfg.n_bottom, positions, velocity, buf.v_visc, rho, buf.pressure,
+                      buf.eta, f, cfg.mass, lists.start, lists.neighbours, cfg.lx, cfg.lz,
+                      cfg.h_sl, cfg.g_x, v_wall, cfg.gradient_correction, buf.drho, buf.acc,
+                      buf.acc_top, buf.grad, buf.grad_c, buf.lap_f, buf.grad_f)
+    else:
+        wall_pass(nf, cfg.n_bottom, positions, velocity, rho, buf.pressure, buf.v_visc,
+                  lists.start, lists.neighbours, cfg.lx, cfg.h_sl, cfg.rho0, cfg.c, cfg.p_b,
+                  cfg.g_x, v_wall, wall[WALL_ACCELERATION])
+        fluid_pass(nf, cfg.n_bottom, positions, velocity, buf.v_visc, rho, buf.pressure,
+                   buf.eta, f, cfg.mass, lists.start, lists.neighbours, cfg.lx, cfg.h_sl,
+                   cfg.g_x, v_wall, cfg.gradient_correction, buf.drho, buf.acc, buf.acc_top,
+                   buf.grad, buf.grad_c, buf.lap_f, buf.grad_f)
     drag = 0.0
     for i in range(nf):
         g = buf.grad[i]
-        gdot = shear_rate_2d(g[0], g[1], g[2], g[3])
+        gdot = shear_rate_3d(g) if cfg.dimension == 3 else shear_rate_2d(g[0], g[1], g[2], g[3])
         buf.gdot[i] = gdot
         buf.sigma[i] = buf.eta[i] * gdot
         buf.df[i] = microstructure_rate(f[i], gdot, buf.eta[i], cfg.K_f, cfg.sigma_star,
@@ -118,6 +141,15 @@ def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
     return STEP_OK
 
 
+@njit(inline="always", **JIT_OPTIONS)
+def _norm2(vectors, i, d):
+    """|vectors[i]|² over the first d components."""
+    s = vectors[i, 0] ** 2 + vectors[i, 1] ** 2
+    if d == 3:
+        s += vectors[i, 2] ** 2
+    return s
+
+
 @njit(**JIT_OPTIONS)
 def time_step(cfg, buf):
     """δt = min(C_c h/c, C_ν ρ0 h²/η_max, C_a sqrt(h/a_max), C_α h²/α), h = h_sl (Morris 1997)."""
@@ -126,7 +158,7 @@ def time_step(cfg, buf):
     a2_max = 0.0
     for i in range(cfg.n_fluid):
         eta_max = max(eta_max, buf.eta[i])
-        a2_max = max(a2_max, buf.acc[i, 0] ** 2 + buf.acc[i, 1] ** 2)
+        a2_max = max(a2_max, _norm2(buf.acc, i, cfg.dimension))
     dt = cfg.courant * h / cfg.c
     if eta_max > 0.0:
         dt = min(dt, cfg.viscous_number * cfg.rho0 * h * h / eta_max)
@@ -141,7 +173,8 @@ def time_step(cfg, buf):
 def _move_top_wall(cfg, positions, source, dx):
     for w in range(cfg.n_fluid + cfg.n_bottom, positions.shape[0]):
         positions[w, 0] = source[w, 0] + dx
-        positions[w, 1] = source[w, 1]
+        for a in range(1, cfg.dimension):
+            positions[w, a] = source[w, a]
 
 
 @njit(**JIT_OPTIONS)
@@ -155,9 +188,11 @@ def _check(cfg, positions, velocity, rho, f, wall, eta):
         if eta[i] > cfg.max_viscosity_ratio * cfg.eta_s:
             return NEAR_JAMMING
         s = positions[i, 0] + positions[i, 1] + velocity[i, 0] + velocity[i, 1] + rho[i] + f[i]
+        if cfg.dimension == 3:
+            s += positions[i, 2] + velocity[i, 2]
         if not math.isfinite(s):
             return NONFINITE
-        v2_max = max(v2_max, velocity[i, 0] ** 2 + velocity[i, 1] ** 2)
+        v2_max = max(v2_max, _norm2(velocity, i, cfg.dimension))
         err = max(err, abs(rho[i] / cfg.rho0 - 1.0))
     if not math.isfinite(wall[WALL_VELOCITY]):
         return NONFINITE
@@ -179,6 +214,7 @@ def advance_steps(cfg, n_steps, t_stop, positions, velocity, rho, f, wall, half_
     """
     nf = cfg.n_fluid
     n = positions.shape[0]
+    d = cfg.dimension
     for step in range(n_steps):
         if clock[0] >= t_stop:
             return STEP_OK, step
@@ -191,14 +227,14 @@ def advance_steps(cfg, n_steps, t_stop, positions, velocity, rho, f, wall, half_
         a_wall0 = wall[WALL_ACCELERATION]
         # Predictor: half step with the rates at n.
         for i in range(nf):
-            for a in range(2):
+            for a in range(d):
                 half_positions[i, a] = positions[i, a] + half * velocity[i, a]
                 half_velocity[i, a] = velocity[i, a] + half * buf.acc[i, a]
             half_rho[i] = rho[i] + half * buf.drho[i]
             half_f[i] = min(max(f[i] + half * buf.df[i], 0.0), 1.0)
         for w in range(nf, n):
-            half_positions[w, 0] = positions[w, 0]
-            half_positions[w, 1] = positions[w, 1]
+            for a in range(d):
+                half_positions[w, a] = positions[w, a]
             half_rho[w] = rho[w]
         _move_top_wall(cfg, half_positions, positions, half * v_wall0)
         wall[WALL_VELOCITY] = v_wall0 + half * a_wall0
@@ -210,7 +246,7 @@ def advance_steps(cfg, n_steps, t_stop, positions, velocity, rho, f, wall, half_
             return code, step
         v_wall_half = wall[WALL_VELOCITY]
         for i in range(nf):
-            for a in range(2):
+            for a in range(d):
                 positions[i, a] += dt * half_velocity[i, a]
                 velocity[i, a] += dt * buf.acc[i, a]
             rho[i] += dt * buf.drho[i]
@@ -231,40 +267,53 @@ def advance_steps(cfg, n_steps, t_stop, positions, velocity, rho, f, wall, half_
 
 @njit(**JIT_OPTIONS)
 def _shift(cfg, positions, velocity, f, buf, dt):
-    """Lind et al. 2012 shifting δx = −A h |v| δt ∇C, clipped at 0.1 h, with Taylor corrections."""
+    """Lind et al. 2012 shifting δx = −A h |v| δt ∇C, clipped at 0.1 h, with Taylor corrections
+    (δx_z = 0 in 2D)."""
     h = cfg.h_sl
     cap = 0.1 * h
+    d = cfg.dimension
     for i in range(cfg.n_fluid):
-        speed = math.sqrt(velocity[i, 0] ** 2 + velocity[i, 1] ** 2)
-        d = cfg.shifting_coefficient * h * speed * dt
-        sx = -d * buf.grad_c[i, 0]
-        sy = -d * buf.grad_c[i, 1]
-        size = math.sqrt(sx * sx + sy * sy)
+        speed = math.sqrt(_norm2(velocity, i, d))
+        D = cfg.shifting_coefficient * h * speed * dt
+        sx = -D * buf.grad_c[i, 0]
+        sy = -D * buf.grad_c[i, 1]
+        sz = -D * buf.grad_c[i, 2] if d == 3 else 0.0
+        size = math.sqrt(sx * sx + sy * sy + sz * sz)
         if size > cap:
             sx *= cap / size
             sy *= cap / size
+            sz *= cap / size
         g = buf.grad[i]
         positions[i, 0] += sx
         positions[i, 1] += sy
-        velocity[i, 0] += g[0] * sx + g[1] * sy
-        velocity[i, 1] += g[2] * sx + g[3] * sy
-        f[i] = min(max(f[i] + buf.grad_f[i, 0] * sx + buf.grad_f[i, 1] * sy, 0.0), 1.0)
+        gf = buf.grad_f[i]
+        if d == 3:
+            positions[i, 2] += sz
+            for a in range(3):
+                velocity[i, a] += g[3 * a] * sx + g[3 * a + 1] * sy + g[3 * a + 2] * sz
+            f[i] = min(max(f[i] + gf[0] * sx + gf[1] * sy + gf[2] * sz, 0.0), 1.0)
+        else:
+            velocity[i, 0] += g[0] * sx + g[1] * sy
+            velocity[i, 1] += g[2] * sx + g[3] * sy
+            f[i] = min(max(f[i] + gf[0] * sx + gf[1] * sy, 0.0), 1.0)
 
 
-def allocate_buffers(n_particles: int) -> Buffers:
-    """Zeroed work arrays for ``n_particles`` (fluid and wall)."""
-    n = int(n_particles)
+def allocate_buffers(n_particles: int, dimension: int = 2) -> Buffers:
+    """Zeroed work arrays for ``n_particles`` (fluid and wall) in ``dimension`` d: vectors
+    (N, d), the velocity gradient (N, d²) row by row."""
+    n, d = int(n_particles), int(dimension)
     z1 = lambda: np.zeros(n)  # noqa: E731
-    z2 = lambda k=2: np.zeros((n, k))  # noqa: E731
+    z2 = lambda k=d: np.zeros((n, k))  # noqa: E731
     return Buffers(pressure=z1(), eta=z1(), v_visc=z2(), drho=z1(), acc=z2(), acc_top=z1(),
-                   grad=z2(4), grad_c=z2(), lap_f=z1(), grad_f=z2(), gdot=z1(), sigma=z1(),
+                   grad=z2(d * d), grad_c=z2(), lap_f=z1(), grad_f=z2(), gdot=z1(), sigma=z1(),
                    df=z1())
 
 
-def allocate_lists(n_particles: int, capacity: int) -> ListArrays:
+def allocate_lists(n_particles: int, capacity: int, dimension: int = 2) -> ListArrays:
     """Neighbour-list arrays with ``capacity`` pair slots (a rebuild is forced at first use)."""
     n = int(n_particles)
     return ListArrays(start=np.zeros(n + 1, dtype=np.int64),
                       neighbours=np.zeros(int(capacity), dtype=np.int64),
                       cell_of=np.zeros(n, dtype=np.int64), order=np.zeros(n, dtype=np.int64),
-                      reference=np.zeros((n, 2)), force_rebuild=np.ones(1, dtype=np.int64))
+                      reference=np.zeros((n, int(dimension))),
+                      force_rebuild=np.ones(1, dtype=np.int64))

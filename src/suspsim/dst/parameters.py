@@ -1,4 +1,4 @@
-"""Parameters of a 2D wall-bounded DST run: fluid, geometry, flow and numerics (SPEC §1.3, §5).
+"""Parameters of a wall-bounded DST run (2D or 3D): fluid, geometry, flow, numerics (SPEC §1.3, §5).
 
 Every class validates itself when built and raises :class:`~suspsim.errors.InputError` naming
 the key to change. Units are any consistent set (seed 002: SI; the validation uses scaled units,
@@ -15,6 +15,7 @@ beta            sharpness β of f̂ = exp(−(σ*/σ)^β)                       
 K_f             relaxation constant of f (rate K_f γ̇)                     1
 alpha           diffusivity α of f (non-locality)                         m²/s
 n_x, n_y        fluid particles along x (periodic) and across the gap     1
+n_z             fluid particles along z (periodic; 3D only, None in 2D)   1
 gap             wall-to-wall distance L_y; Δx = gap/n_y, L_x = n_x Δx      m
 smoothing_ratio h_sl/Δx of the quintic spline (seed 002: 1.1)             1
 density         reference density ρ0                                      kg/m³
@@ -115,7 +116,8 @@ class WyartCatesFluid:
 
 @dataclass(frozen=True)
 class Geometry:
-    """Lattice of n_x × n_y fluid particles filling 0 < y < gap, x periodic over n_x Δx.
+    """Lattice of n_x × n_y fluid particles filling 0 < y < gap, x periodic over n_x Δx; with
+    ``n_z``, a 3D lattice n_x × n_y × n_z, z periodic over n_z Δx as well.
 
     Walls lie exactly at y = 0 and y = gap; ``wall_layers`` rows of dummy particles sit outside
     (None: enough for the quintic support 3 h_sl, i.e. ceil(3 · smoothing_ratio)).
@@ -126,9 +128,10 @@ class Geometry:
     gap: float
     smoothing_ratio: float = 1.1
     wall_layers: int | None = None
+    n_z: int | None = None
 
     def __post_init__(self):
-        for name in ("n_x", "n_y"):
+        for name in ("n_x", "n_y") + (() if self.n_z is None else ("n_z",)):
             value = getattr(self, name)
             if int(value) != value or value < 4:
                 raise InputError(_SOURCE, f"geometry.{name} = {value!r} must be an integer >= 4",
@@ -144,11 +147,22 @@ class Geometry:
         elif int(self.wall_layers) < needed:
             raise InputError(_SOURCE, f"geometry.wall_layers = {self.wall_layers} is fewer than "
                              f"the {needed} the kernel support 3 h_sl needs", key="wall_layers")
-        # The periodic x needs the cell grid of the list to hold 3 cells of h + skin.
-        if self.n_x < 3 * (3.0 * self.smoothing_ratio * 1.2) + 1:
-            raise InputError(_SOURCE, f"geometry.n_x = {self.n_x} is too small for the periodic "
-                             f"direction; need n_x >= {math.ceil(10.8 * self.smoothing_ratio) + 1}",
-                             key="n_x")
+        # A periodic direction needs the cell grid of the list to hold 3 cells of h + skin.
+        for name in ("n_x",) + (() if self.n_z is None else ("n_z",)):
+            if getattr(self, name) < 3 * (3.0 * self.smoothing_ratio * 1.2) + 1:
+                raise InputError(_SOURCE, f"geometry.{name} = {getattr(self, name)} is too small "
+                                 f"for the periodic direction; need {name} >= "
+                                 f"{math.ceil(10.8 * self.smoothing_ratio) + 1}", key=name)
+
+    @property
+    def dimension(self) -> int:
+        """2, or 3 with ``n_z``."""
+        return 2 if self.n_z is None else 3
+
+    @property
+    def depth(self) -> float | None:
+        """Periodic length L_z = n_z Δx [m] in 3D (None in 2D)."""
+        return None if self.n_z is None else self.n_z * self.spacing
 
     @property
     def spacing(self) -> float:
@@ -170,8 +184,9 @@ class Geometry:
 class StressCouette:
     """Stress-controlled shear (SPEC §5.4): bottom wall fixed, top wall driven by σ_in.
 
-    M_w dV_w/dt = σ_in A_w − F_r, A_w = L_x per unit depth; ``wall_mass`` M_w per unit depth
-    (None: the total mass of the top wall's dummy particles [choice]).
+    M_w dV_w/dt = σ_in A_w − F_r, A_w = L_x per unit depth (2D) or L_x L_z (3D); ``wall_mass``
+    M_w [kg/m per unit depth in 2D, kg in 3D] (None: the total mass of the top wall's dummy
+    particles [choice]).
     """
 
     stress: float

@@ -241,7 +241,7 @@ def write_dst_output(out: Path, scene: DSTScene, sim, record: DSTRecord,
     if couette:
         attrs["wall_mass"] = sim.config.wall_mass
     title = (f"suspsim DST run: {scene.flow_type} flow of a Wyart-Cates suspension between "
-             f"walls, phi = {fluid.phi:g}, alpha = {fluid.alpha:g} (2-D)")
+             f"walls, phi = {fluid.phi:g}, alpha = {fluid.alpha:g} ({scene.dimension}-D)")
     write_run(out, data, attrs, scene, title=title, registry=dst_registry(scene.units == "SI"))
     log.info("wrote %s (%s, %d blocks; Re %.3g, max Mach %.3g)", out, attrs["averaging_method"],
              attrs["averaging_blocks"], attrs["reynolds_number"], attrs["mach_number"])

@@ -9,9 +9,10 @@ cross-key rules here, and maps it onto :class:`~suspsim.dst.parameters.WyartCate
 Every problem is one :class:`~suspsim.errors.InputError` line naming file, line and key.
 
 Units: any consistent set (issue 5) — seed 002 is SI; scaled scenes take η_s = σ* = L_y = 1.
-Geometry: walls at y = 0 and y = box[1] (dummy layers outside), x periodic over box[0];
-``resolution`` fluid particles across the gap, spacing Δx = box[1]/resolution, box[0]/Δx
-along x. Time: ``run.strain`` counts the nominal strain γ̇_WC t, γ̇_WC = σ_in/η(f̂(σ_in)) the
+Geometry: ``dimension`` 2 or 3; walls at y = 0 and y = box[1] (dummy layers outside), x
+periodic over box[0] and, in 3D, z periodic over box[2] (box = [L_x, L_y, L_z]); ``resolution``
+fluid particles across the gap, spacing Δx = box[1]/resolution, box[0]/Δx along x (box[2]/Δx
+along z). Time: ``run.strain`` counts the nominal strain γ̇_WC t, γ̇_WC = σ_in/η(f̂(σ_in)) the
 steady rate of the imposed stress (stress_couette only).
 
 Resolved defaults [choices, documented in the schema]: ``numerics.density: auto`` for
@@ -45,7 +46,7 @@ DST_LAW = "wyart_cates"
 AUTO_OUTPUT_STRAIN = 0.05
 AUTO_OUTPUT_MIN_SAMPLES = 20
 AUTO_OUTPUT_SAMPLES_CHANNEL = 200
-#: box[0] must be this close (relative) to a whole number of lattice spacings.
+#: box[0] (and box[2]) must be this close (relative) to a whole number of lattice spacings.
 LATTICE_TOLERANCE = 1e-6
 
 
@@ -90,9 +91,10 @@ class DSTRunSpec:
 
 @dataclass(frozen=True)
 class DSTScene(RunTimes):
-    """A complete, validated DST scene (see the module docstring); ``box`` = (L_x, L_y)."""
+    """A complete, validated DST scene (see the module docstring); ``box`` = (L_x, L_y) or
+    (L_x, L_y, L_z)."""
 
-    box: tuple[float, float]
+    box: tuple[float, ...]
     resolution: int
     units: str
     fluid: WyartCatesFluid
@@ -105,7 +107,7 @@ class DSTScene(RunTimes):
 
     @property
     def dimension(self) -> int:
-        return 2
+        return self.geometry.dimension
 
     @property
     def flow_type(self) -> str:
@@ -167,11 +169,11 @@ def build_dst_scene(data, source: str, lines: Mapping[tuple, int]) -> DSTScene:
     _check_solver(data, fail)
     validate(data, DST_SCENE_SCHEMA, source=source, lines=lines)
     full = fill_defaults(data, DST_SCENE_SCHEMA)
-    if full["dimension"] != 2:
-        fail(("dimension",), "DST scenes (law wyart_cates) run in 2-D only: the walls are not "
-                             "implemented in 3-D; set dimension: 2")
-    if len(full["box"]) != 2:
-        fail(("box",), f"a 2-D scene needs 2 box lengths (x, y), got {len(full['box'])}")
+    dimension = full["dimension"]
+    if len(full["box"]) != dimension:
+        axes = "x, y" if dimension == 2 else "x, y, z"
+        fail(("box",), f"a {dimension}-D scene needs {dimension} box lengths ({axes}), got "
+                       f"{len(full['box'])}")
     kind = full["flow"]["type"]
     fluid = _made(WyartCatesFluid, full["fluid"]["params"], ("fluid", "params"), fail)
     flow = _flow(full["flow"], fail)
@@ -180,7 +182,7 @@ def build_dst_scene(data, source: str, lines: Mapping[tuple, int]) -> DSTScene:
     rate = _check_start(fluid, flow, full, run, fail)
     numerics = _numerics(full["numerics"], flow, fluid, rate, full["box"][1], fail)
     complete = {**full, "run": _run_dict(run)}
-    return DSTScene(box=(float(full["box"][0]), float(full["box"][1])),
+    return DSTScene(box=tuple(float(side) for side in full["box"]),
                     resolution=int(full["resolution"]), units=full["units"], fluid=fluid,
                     flow=flow, geometry=geometry, numerics=numerics, run=run,
                     complete=complete, source=source)
@@ -237,26 +239,37 @@ def _flow(flow: dict, fail):
 
 
 def _geometry(full: dict, fail) -> Geometry:
-    length, gap = (float(side) for side in full["box"])
+    gap = float(full["box"][1])
     n_y = int(full["resolution"])
     spacing = gap / n_y
-    n_x = round(length / spacing)
-    if abs(n_x * spacing / length - 1) > LATTICE_TOLERANCE:
-        fail(("box", 0), f"box[0] = {length:g} is not a whole number of lattice spacings "
-                         f"box[1]/resolution = {spacing:.6g}; use e.g. {max(n_x, 1) * spacing:.6g}")
     ratio, skin = float(full["numerics"]["smoothing_ratio"]), float(full["numerics"]["skin"])
     # Geometry's periodic-direction rule and DSTSimulation's three list cells of (3 + skin) h_sl.
     needed = math.ceil(max(10.8 * ratio + 1, 3 * (3 + skin) * ratio) - 1e-9)
-    if n_x < needed:
-        fail(("box", 0), f"box[0] holds {n_x} lattice spacings; the periodic direction needs at "
-                         f"least {needed}: make box[0] >= {needed * spacing:.6g}")
+    # The periodic directions: x, and z in 3D.
+    counts = {index: _periodic_count(full["box"], index, spacing, needed, fail)
+              for index in (0, 2)[:len(full["box"]) - 1]}
     layers = full["numerics"]["wall_layers"]
-    values = {"n_x": n_x, "n_y": n_y, "gap": gap, "smoothing_ratio": ratio,
-              "wall_layers": None if layers == "auto" else layers}
+    values = {"n_x": counts[0], "n_y": n_y, "gap": gap, "smoothing_ratio": ratio,
+              "wall_layers": None if layers == "auto" else layers, "n_z": counts.get(2)}
     rename = {"n_x": ("box", 0), "n_y": ("resolution",), "gap": ("box", 1),
-              "smoothing_ratio": ("numerics", "smoothing_ratio"),
+              "n_z": ("box", 2), "smoothing_ratio": ("numerics", "smoothing_ratio"),
               "wall_layers": ("numerics", "wall_layers")}
     return _made(Geometry, values, (), fail, rename)
+
+
+def _periodic_count(box, index: int, spacing: float, needed: int, fail) -> int:
+    """Lattice spacings along the periodic box[index]: a whole number, at least ``needed``."""
+    length = float(box[index])
+    count = round(length / spacing)
+    if abs(count * spacing / length - 1) > LATTICE_TOLERANCE:
+        fail(("box", index), f"box[{index}] = {length:g} is not a whole number of lattice "
+                             f"spacings box[1]/resolution = {spacing:.6g}; use e.g. "
+                             f"{max(count, 1) * spacing:.6g}")
+    if count < needed:
+        fail(("box", index), f"box[{index}] holds {count} lattice spacings; the periodic "
+                             f"direction needs at least {needed}: make box[{index}] >= "
+                             f"{needed * spacing:.6g}")
+    return count
 
 
 def _run(run: dict, kind: str, resolution: int, fail) -> DSTRunSpec:

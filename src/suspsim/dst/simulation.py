@@ -1,8 +1,10 @@
-"""`DSTSimulation`: a 2D wall-bounded Wyart–Cates SPH run (seed 002; SPEC §1.3, §5).
+"""`DSTSimulation`: a wall-bounded Wyart–Cates SPH run in 2D or 3D (seed 002; SPEC §1.3, §5).
 
 Set-up: a lattice of n_x × n_y fluid particles fills 0 < y < L_y (spacing Δx, x periodic over
 L_x = n_x Δx, mass m = ρ0 Δx² per unit depth); walls lie exactly at y = 0 and y = L_y with
-``wall_layers`` rows of dummy particles at y = −(k + ½)Δx and L_y + (k + ½)Δx. Flows:
+``wall_layers`` rows of dummy particles at y = −(k + ½)Δx and L_y + (k + ½)Δx. In 3D
+(``Geometry.n_z``) the lattice, walls included, repeats over n_z planes, z periodic over
+L_z = n_z Δx, m = ρ0 Δx³, and the driven wall's area is A_w = L_x L_z. Flows:
 
 * :class:`~suspsim.dst.parameters.StressCouette` — bottom wall fixed, top wall driven by σ_in
   through M_w dV_w/dt = σ_in A_w − F_r; starts (SPEC §5.4) from f = f̂(σ_in), the matching rate
@@ -51,16 +53,16 @@ _MESSAGES = {
 
 
 class DSTSimulation:
-    """A 2D SPH run of a Wyart–Cates suspension between walls (see the module docstring).
+    """An SPH run (2D or 3D) of a Wyart–Cates suspension between walls (module docstring).
 
     Parameters
     ----------
     fluid : WyartCatesFluid
         η_s [Pa s], φ, φ_m, φ_0 [1], σ* [Pa], β [1], K_f [1], α [m²/s].
     flow : StressCouette or Channel
-        σ_in [Pa] (and M_w [kg/m]) or the body acceleration g [m/s²].
+        σ_in [Pa] (and M_w [kg/m in 2D, kg in 3D]) or the body acceleration g [m/s²].
     geometry : Geometry
-        n_x, n_y, gap L_y [m], h_sl/Δx, wall layers.
+        n_x, n_y (and n_z in 3D), gap L_y [m], h_sl/Δx, wall layers.
     numerics : Numerics, optional
         ρ0 [kg/m³], sound speed [m/s], step coefficients, shifting, blow-up limits.
     threads : int, optional
@@ -89,22 +91,23 @@ class DSTSimulation:
     def _build(self, initial_fraction):
         geo, num, fluid = self.geometry, self.numerics, self.fluid
         dx, ly, lx = geo.spacing, geo.gap, geo.length
+        d = self.dimension = geo.dimension
         layers = geo.wall_layers
         h_sl = geo.smoothing_length
         xs = (np.arange(geo.n_x) + 0.5) * dx
-        ys = (np.arange(geo.n_y) + 0.5) * dx
-        fx, fy = np.meshgrid(xs, ys, indexing="ij")
-        fluid_xy = np.column_stack([fx.ravel(), fy.ravel()])
+        zs = () if d == 2 else ((np.arange(geo.n_z) + 0.5) * dx,)
+
+        def lattice(ys):
+            return np.column_stack([c.ravel() for c in np.meshgrid(xs, ys, *zs, indexing="ij")])
+
         wy = (np.arange(layers) + 0.5) * dx
-        bx, by = np.meshgrid(xs, -wy, indexing="ij")
-        tx, ty = np.meshgrid(xs, ly + wy, indexing="ij")
-        bottom = np.column_stack([bx.ravel(), by.ravel()])
-        top = np.column_stack([tx.ravel(), ty.ravel()])
+        fluid_xy = lattice((np.arange(geo.n_y) + 0.5) * dx)
+        bottom, top = lattice(-wy), lattice(ly + wy)
         self.positions_all = np.ascontiguousarray(np.vstack([fluid_xy, bottom, top]))
         self.n_fluid, self.n_wall = len(fluid_xy), len(bottom)
         n = len(self.positions_all)
         rho0 = num.density
-        mass = rho0 * dx * dx
+        mass = rho0 * dx * dx if d == 2 else rho0 * dx * dx * dx
         y = fluid_xy[:, 1]
 
         couette = isinstance(self.flow, StressCouette)
@@ -120,7 +123,8 @@ class DSTSimulation:
             g_x = 0.0
             wall_mass = (self.flow.wall_mass if self.flow.wall_mass is not None
                          else mass * self.n_wall)
-            v_init = np.column_stack([rate0 * y, np.zeros_like(y)])
+            v_init = np.zeros((self.n_fluid, d))
+            v_init[:, 0] = rate0 * y
             wall_velocity = rate0 * ly
         else:
             g_x = self.flow.body_force
@@ -133,7 +137,7 @@ class DSTSimulation:
             f_init = np.array([fluid.frictional_fraction(abs(force * (half - yy))) for yy in y])
             if initial_fraction is not None:
                 f_init = np.clip(np.array([float(initial_fraction(yy)) for yy in y]), 0.0, 1.0)
-            v_init = np.zeros((self.n_fluid, 2))
+            v_init = np.zeros((self.n_fluid, d))
             wall_velocity = 0.0
             rate0 = None
         for f in (f_init.min(), f_init.max()):
@@ -147,23 +151,26 @@ class DSTSimulation:
         self.initial_shear_rate = rate0
         skin = num.skin * h_sl
         cutoff = 3.0 * h_sl + skin
-        if lx < 3.0 * cutoff:
-            raise InputError("DSTSimulation", f"periodic length {lx:g} holds fewer than 3 list "
-                             f"cells of {cutoff:g}; raise geometry.n_x", key="n_x")
+        lz = 0.0 if d == 2 else geo.depth
+        for name, length in (("n_x", lx),) + (() if d == 2 else (("n_z", lz),)):
+            if length < 3.0 * cutoff:
+                raise InputError("DSTSimulation", f"periodic length {length:g} holds fewer than "
+                                 f"3 list cells of {cutoff:g}; raise geometry.{name}", key=name)
         self.config = _int.Config(
-            n_fluid=self.n_fluid, n_bottom=self.n_wall, lx=lx, y_lo=-(layers + 1) * dx,
-            y_hi=ly + (layers + 1) * dx, cutoff=cutoff, skin=skin, h_sl=h_sl, rho0=rho0, c=c,
-            p_b=num.background_pressure, mass=mass, g_x=g_x, stress_control=couette,
-            stress=stress, area=lx, wall_mass=wall_mass, eta_s=fluid.eta_s, phi=fluid.phi,
-            phi_m=fluid.phi_m, phi_0=fluid.phi_0, sigma_star=fluid.sigma_star, beta=fluid.beta,
-            K_f=fluid.K_f, alpha=fluid.alpha, courant=num.courant,
+            dimension=d, n_fluid=self.n_fluid, n_bottom=self.n_wall, lx=lx, lz=lz,
+            y_lo=-(layers + 1) * dx, y_hi=ly + (layers + 1) * dx, cutoff=cutoff, skin=skin,
+            h_sl=h_sl, rho0=rho0, c=c, p_b=num.background_pressure, mass=mass, g_x=g_x,
+            stress_control=couette, stress=stress, area=lx if d == 2 else lx * lz,
+            wall_mass=wall_mass, eta_s=fluid.eta_s, phi=fluid.phi, phi_m=fluid.phi_m,
+            phi_0=fluid.phi_0, sigma_star=fluid.sigma_star, beta=fluid.beta, K_f=fluid.K_f,
+            alpha=fluid.alpha, courant=num.courant,
             viscous_number=num.viscous_number, force_number=num.force_number,
             diffusion_number=num.diffusion_number, shifting=num.shifting,
             shifting_coefficient=num.shifting_coefficient,
             gradient_correction=num.gradient_correction,
             max_density_error=num.max_density_error, max_mach=num.max_mach,
             max_viscosity_ratio=num.max_viscosity_ratio)
-        self.velocity_all = np.zeros((n, 2))
+        self.velocity_all = np.zeros((n, d))
         self.velocity_all[:self.n_fluid] = v_init
         self.velocity_all[self.n_fluid + self.n_wall:, 0] = wall_velocity
         self.rho_all = np.full(n, rho0)
@@ -171,10 +178,12 @@ class DSTSimulation:
         self.f_all[:self.n_fluid] = f_init
         self.wall = np.array([wall_velocity, 0.0])
         self.clock = np.zeros(2)
-        self._half = (np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n), np.zeros(n))
-        self._buffers = _int.allocate_buffers(n)
-        area = math.pi * cutoff * cutoff / (dx * dx)
-        self._lists = _int.allocate_lists(n, int(1.5 * area * n) + 64)
+        self._half = (np.zeros((n, d)), np.zeros((n, d)), np.zeros(n), np.zeros(n))
+        self._buffers = _int.allocate_buffers(n, d)
+        # lattice sites within the list cutoff: the disc (2D) or ball (3D) of radius r_c
+        sites = (math.pi * (cutoff / dx) ** 2 if d == 2
+                 else 4.0 / 3.0 * math.pi * (cutoff / dx) ** 3)
+        self._lists = _int.allocate_lists(n, int(1.5 * sites * n) + 64, d)
         self.steps = 0
         self._evaluated = False
         self._wall_acceleration = 0.0
@@ -303,45 +312,50 @@ class DSTSimulation:
                                  f"{target.shape}")
             target[...] = value
         self.steps = int(state["steps"])
-        self._lists = _int.allocate_lists(n, int(state["list_capacity"]))
+        self._lists = _int.allocate_lists(n, int(state["list_capacity"]), self.dimension)
         if not int(state["list_stale"]):
             reference = np.ascontiguousarray(np.asarray(state["list_reference"], dtype=float))
             self._run(_int.refresh_list, self.config, reference, self._lists)
         self._evaluated = False
 
     def snapshot(self) -> dict:
-        """Per-particle copies of the fluid: x, y [m], v_x, v_y [m/s], rho, f [1], eta [Pa s],
-        shear_rate [1/s], stress [Pa] (σ = η γ̇), pressure."""
+        """Per-particle copies of the fluid: x, y [m], v_x, v_y [m/s] (3D: z, v_z too), rho,
+        f [1], eta [Pa s], shear_rate [1/s], stress [Pa] (σ = η γ̇), pressure."""
         self._evaluate()
         nf = self.n_fluid
         b = self._buffers
-        return {"x": self.positions_all[:nf, 0].copy(), "y": self.positions_all[:nf, 1].copy(),
-                "v_x": self.velocity_all[:nf, 0].copy(), "v_y": self.velocity_all[:nf, 1].copy(),
-                "rho": self.rho_all[:nf].copy(), "f": self.f_all[:nf].copy(),
-                "eta": b.eta[:nf].copy(), "shear_rate": b.gdot[:nf].copy(),
-                "stress": b.sigma[:nf].copy(), "pressure": b.pressure[:nf].copy()}
+        out = {"x": self.positions_all[:nf, 0].copy(), "y": self.positions_all[:nf, 1].copy(),
+               "v_x": self.velocity_all[:nf, 0].copy(), "v_y": self.velocity_all[:nf, 1].copy(),
+               "rho": self.rho_all[:nf].copy(), "f": self.f_all[:nf].copy(),
+               "eta": b.eta[:nf].copy(), "shear_rate": b.gdot[:nf].copy(),
+               "stress": b.sigma[:nf].copy(), "pressure": b.pressure[:nf].copy()}
+        if self.dimension == 3:
+            out["z"] = self.positions_all[:nf, 2].copy()
+            out["v_z"] = self.velocity_all[:nf, 2].copy()
+        return out
 
     def rates(self) -> dict:
         """Rates and gradients of the fluid particles at the current state (copies):
-        drho_dt, acceleration (n_f, 2), velocity_gradient (n_f, 2, 2) with [a, b] = ∂v_a/∂x_b,
-        laplacian_f, gradient_f (n_f, 2), df_dt, colour_gradient ∇C (n_f, 2) with
+        drho_dt, acceleration (n_f, d), velocity_gradient (n_f, d, d) with [a, b] = ∂v_a/∂x_b,
+        laplacian_f, gradient_f (n_f, d), df_dt, colour_gradient ∇C (n_f, d) with
         C_i = Σ_j V_j W_ij (≈ 0 in a regular arrangement; shifting drives it down), and the
         top-wall dV_w/dt."""
         self._evaluate()
         nf = self.n_fluid
         b = self._buffers
         return {"drho_dt": b.drho[:nf].copy(), "acceleration": b.acc[:nf].copy(),
-                "velocity_gradient": b.grad[:nf].reshape(nf, 2, 2).copy(),
+                "velocity_gradient": b.grad[:nf].reshape(nf, self.dimension,
+                                                         self.dimension).copy(),
                 "laplacian_f": b.lap_f[:nf].copy(), "gradient_f": b.grad_f[:nf].copy(),
                 "df_dt": b.df[:nf].copy(), "colour_gradient": b.grad_c[:nf].copy(),
                 "wall_acceleration": self._wall_acceleration}
 
     def set_state(self, *, velocity=None, fraction=None, positions=None) -> None:
-        """Overwrite fluid velocities (n_f, 2), fractions f (n_f,) or positions (n_f, 2)."""
+        """Overwrite fluid velocities (n_f, d), fractions f (n_f,) or positions (n_f, d)."""
         nf = self.n_fluid
         for value, target in ((velocity, self.velocity_all), (positions, self.positions_all)):
             if value is not None:
-                target[:nf] = np.asarray(value, dtype=float).reshape(nf, 2)
+                target[:nf] = np.asarray(value, dtype=float).reshape(nf, self.dimension)
         if fraction is not None:
             self.f_all[:nf] = np.asarray(fraction, dtype=float).reshape(nf)
         if positions is not None:
@@ -353,7 +367,7 @@ class DSTSimulation:
         shear_rate ⟨γ̇⟩, fraction ⟨f⟩, mean_velocity ⟨v_x⟩, wall_shear_rate V_w/L_y, the
         largest |ρ/ρ0 − 1| (density_error) and the Mach number max |v|/c (mach)."""
         snap = self.snapshot()
-        speed = np.sqrt(snap["v_x"] ** 2 + snap["v_y"] ** 2)
+        speed = np.sqrt(snap["v_x"] ** 2 + snap["v_y"] ** 2 + snap.get("v_z", 0.0) ** 2)
         return {"time": self.time, "wall_velocity": self.wall_velocity,
                 "stress": float(snap["stress"].mean()),
                 "shear_rate": float(snap["shear_rate"].mean()),

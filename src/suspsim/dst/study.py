@@ -15,7 +15,8 @@ time is counted in η_s/σ* and rates in σ*/η_s (0.2 s and 5 /s for seed 002).
 One point (SPEC §5.4):
 
 1. fluid ``WyartCatesFluid(1, φ, φ_m, φ_0, 1, β, K_f, α)``, flow ``StressCouette(σ_in)``,
-   geometry ``Geometry(n_x, n_y, 1)``, start at the fixed point f = f̂(σ_in), V_w = γ̇_WC L_y;
+   geometry ``Geometry(n_x, n_y, 1)`` (3D: ``n_z`` too, :func:`lattice_geometry`), start at
+   the fixed point f = f̂(σ_in), V_w = γ̇_WC L_y;
 2. density ρ = ε σ_in/(K_f γ̇_WC²), i.e. ε = K_f γ̇ ρ L_y²/η (momentum time over
    microstructure time) = 0.1 by default: momentum follows the microstructure, so the
    homogeneous state on the unstable branch stays homogeneous; Re = ρ γ̇ L_y²/η = ε/K_f. All
@@ -108,8 +109,14 @@ FLOW_CURVE_VARIABLES = {
 _PHYSICAL_UNITS = {"wall_time": "s"}
 
 
+def lattice_geometry(lattice) -> Geometry:
+    """The unit-gap Geometry of ``lattice`` = (n_x, n_y) or, in 3D, (n_x, n_y, n_z)."""
+    return Geometry(int(lattice[0]), int(lattice[1]), 1.0,
+                    n_z=int(lattice[2]) if len(lattice) > 2 else None)
+
+
 def flow_curve(phi: float, stresses, *, alpha: float = STRONG_NONLOCALITY,
-               lattice: tuple[int, int] = (14, 20), threads: int = 1, epsilon: float = 0.1,
+               lattice: tuple[int, ...] = (14, 20), threads: int = 1, epsilon: float = 0.1,
                equilibration_strain: float = 1.5, averaging_strain: float = 1.5,
                samples: int = 16, n_blocks: int = 8, phi_m: float = SEED_002["phi_m"],
                phi_0: float = SEED_002["phi_0"], beta: float = SEED_002["beta"],
@@ -121,7 +128,8 @@ def flow_curve(phi: float, stresses, *, alpha: float = STRONG_NONLOCALITY,
     phi : solid volume fraction φ [1], 0 < φ < φ_0.
     stresses : imposed stresses σ_in [σ*], positive (one run each, in the given order).
     alpha : diffusivity of f [L_y² σ*/η_s] (:data:`STRONG_NONLOCALITY` = seed 002's 1e−5 m²/s).
-    lattice : fluid particles (n_x periodic, n_y across the gap).
+    lattice : fluid particles (n_x periodic, n_y across the gap); a third number n_z (periodic)
+        makes the run 3D.
     threads : numba threads per run.
     epsilon : momentum time over microstructure time, sets ρ (and Re = ε/K_f).
     equilibration_strain, averaging_strain : γ̇_WC t discarded, then averaged.
@@ -147,7 +155,7 @@ def flow_curve(phi: float, stresses, *, alpha: float = STRONG_NONLOCALITY,
                              "rule needs K_f > 0)", key=name)
     fluid = WyartCatesFluid(eta_s=1.0, phi=phi, phi_m=phi_m, phi_0=phi_0, sigma_star=1.0,
                             beta=beta, K_f=K_f, alpha=alpha)
-    geometry = Geometry(int(lattice[0]), int(lattice[1]), 1.0)
+    geometry = lattice_geometry(lattice)
     settings = {"epsilon": float(epsilon), "equilibration_strain": float(equilibration_strain),
                 "averaging_strain": float(averaging_strain), "samples": int(samples),
                 "n_blocks": int(n_blocks), "threads": int(threads)}
@@ -218,8 +226,8 @@ def flow_curve_dataset(fluid: WyartCatesFluid, geometry: Geometry, stresses, rec
     dataset = xr.Dataset(data, coords={"stress": ("stress", stresses, _attrs("stress"))})
     dataset.attrs = study_attributes(
         fluid, geometry, records, settings, command=command,
-        title=f"Stress-controlled 2D SPH flow curve of a Wyart-Cates suspension, "
-              f"phi = {fluid.phi:g}, alpha = {fluid.alpha:g}",
+        title=f"Stress-controlled {geometry.dimension}D SPH flow curve of a Wyart-Cates "
+              f"suspension, phi = {fluid.phi:g}, alpha = {fluid.alpha:g}",
         source="suspsim.dst.study.flow_curve",
         configuration={"stresses": stresses.tolist()})
     return dataset
@@ -247,7 +255,7 @@ def study_attributes(fluid: WyartCatesFluid, geometry: Geometry, records, settin
         "sigma_star": fluid.sigma_star, "beta": fluid.beta, "K_f": fluid.K_f,
         "alpha": fluid.alpha, "n_x": geometry.n_x, "n_y": geometry.n_y, "gap": geometry.gap,
         "smoothing_ratio": geometry.smoothing_ratio, "wall_layers": geometry.wall_layers,
-        **settings}
+        **({} if geometry.n_z is None else {"n_z": geometry.n_z}), **settings}
     units = {"eta_s": "eta_s", "sigma_star": "sigma_star", "alpha": "L_y2 sigma_star eta_s-1",
              "gap": "L_y", "sigma_beta": _STRESS, "sigma_alpha": _STRESS, "gdot_max": _RATE,
              "gdot_min": _RATE, **(extra_units or {})}
@@ -351,7 +359,7 @@ SPLITTING_VARIABLES = {
 
 
 def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
-                     lattice: tuple[int, int] = (14, 12), threads: int = 1,
+                     lattice: tuple[int, ...] = (14, 12), threads: int = 1,
                      epsilon: float = 0.1, perturbation: float = 0.01, seed: int = 1,
                      equilibration_strain: float = 20.0, averaging_strain: float = 20.0,
                      samples: int = 40, n_blocks: int = 8,
@@ -414,7 +422,7 @@ def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
             or samples % n_blocks:
         raise InputError("stress_splitting", f"samples = {samples} must be a multiple of "
                          f"n_blocks = {n_blocks} >= 2", key="samples")
-    geometry = Geometry(int(lattice[0]), int(lattice[1]), 1.0)
+    geometry = lattice_geometry(lattice)
     settings = {"epsilon": float(epsilon), "perturbation": float(perturbation),
                 "seed": int(seed), "equilibration_strain": float(equilibration_strain),
                 "averaging_strain": float(averaging_strain), "samples": int(samples),
@@ -432,8 +440,8 @@ def stress_splitting(phi: float, stresses, *, alpha: float = LOCAL,
                                                   _attrs("stress", SPLITTING_VARIABLES))})
     dataset.attrs = study_attributes(
         fluid, geometry, records, settings,
-        title=f"Stress splitting of the local Wyart-Cates model in 2D SPH stress-controlled "
-              f"shear, phi = {phi:g}, alpha = {alpha:g}",
+        title=f"Stress splitting of the local Wyart-Cates model in {geometry.dimension}D SPH "
+              f"stress-controlled shear, phi = {phi:g}, alpha = {alpha:g}",
         source="suspsim.dst.study.stress_splitting",
         configuration={"stresses": np.asarray(stresses, dtype=float).tolist()})
     return dataset

@@ -1,4 +1,5 @@
-"""Physics terms of the 2D DST solver: one small ``@njit`` function per equation (SPEC §5.1, §1.3).
+"""Physics terms of the DST solver (2D and 3D): one small ``@njit`` function per equation
+(SPEC §5.1, §1.3).
 
 Pair terms take the pair geometry (x_ij = x_i − x_j, r² and F = −W'(r)/r of the quintic spline,
 so ∇_iW_ij = −x_ij F) and return the contribution to particle i; pair loops live in
@@ -12,13 +13,13 @@ Symbols (SI units; any consistent set works):
 ========= ============================================================ ==========
 symbol    meaning                                                      unit
 ========= ============================================================ ==========
-m         particle mass ρ0 Δx² per unit depth (2D)                      kg/m
+m         particle mass ρ0 Δx^d (2D: ρ0 Δx² per unit depth)            kg (2D: kg/m)
 ρ, ρ0     density, reference density                                   kg/m³
 p, p_b    pressure, background pressure                                Pa
 c         artificial sound speed                                       m/s
 γ_t       Tait exponent (7)                                            1
 x_ij, r   pair vector x_i − x_j, its length                            m
-F         −W'(r)/r, so ∇_iW_ij = −x_ij F                               1/m⁴
+F         −W'(r)/r, so ∇_iW_ij = −x_ij F                               1/m^(d+2)
 h_sl      quintic smoothing length (support 3 h_sl)                    m
 v_ij      v_i − v_j                                                    m/s
 η         viscosity                                                    Pa s
@@ -29,7 +30,10 @@ f, f̂      frictional fraction, its steady value                        1
 K_f, α    relaxation constant, diffusivity of f                        1, m²/s
 ========= ============================================================ ==========
 
-(2D: masses and forces are per unit depth; any consistent units work the same way.)
+(d the dimension; 2D masses and forces are per unit depth; any consistent units work the same
+way.) No term carries a factor of d: Morris's viscous term and Laplacian are dimension-free
+(the kernel's normalisation, :mod:`suspsim.sph.kernels`, holds the dimension), and
+γ̇ = sqrt(2 D:D) sums over the d × d tensor (:func:`shear_rate_2d`, :func:`shear_rate_3d`).
 """
 from __future__ import annotations
 
@@ -71,6 +75,12 @@ def continuity_pair(m_j, vx, vy, x, y, F):
 
 
 @njit(**JIT_OPTIONS)
+def continuity_pair_3d(m_j, vx, vy, vz, x, y, z, F):
+    """:func:`continuity_pair` in 3D: −m_j F (v_ij·x_ij)."""
+    return -m_j * F * (vx * x + vy * y + vz * z)
+
+
+@njit(**JIT_OPTIONS)
 def pressure_pair(m_j, p_i, rho_i, p_j, rho_j, F):
     """Scalar s with −m_j (p_i/ρ_i² + p_j/ρ_j²) ∇_iW_ij = s x_ij, s = m_j (p_i/ρ_i² + p_j/ρ_j²) F.
 
@@ -107,6 +117,20 @@ def shear_rate_2d(gxx, gxy, gyx, gyy):
     """
     s = gxy + gyx
     return math.sqrt(2.0 * gxx * gxx + 2.0 * gyy * gyy + s * s)
+
+
+@njit(**JIT_OPTIONS)
+def shear_rate_3d(g):
+    """γ̇ = sqrt(2 D:D) of G (``g`` the 9 components G_ab at 3a + b, G_ab ≈ ∂v_a/∂x_b):
+    sqrt(2 (G_xx² + G_yy² + G_zz²) + (G_xy + G_yx)² + (G_xz + G_zx)² + (G_yz + G_zy)²).
+
+    |du/dy| in simple shear u = γ̇ y, 0 under rigid rotation (SPEC §1.3).
+    """
+    sxy = g[1] + g[3]
+    sxz = g[2] + g[6]
+    syz = g[5] + g[7]
+    return math.sqrt(2.0 * (g[0] * g[0] + g[4] * g[4] + g[8] * g[8])
+                     + sxy * sxy + sxz * sxz + syz * syz)
 
 
 @njit(**JIT_OPTIONS)

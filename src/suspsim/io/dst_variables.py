@@ -170,7 +170,8 @@ RUN_ATTRIBUTES: Mapping[str, Attribute] = MappingProxyType({a.name: a for a in (
     Attribute("density", float, "reference density rho0 [M L-3]"),
     Attribute("spacing", float, "lattice spacing dx = box[1]/resolution [L]"),
     Attribute("smoothing_length", float, "quintic smoothing length h_sl [L]"),
-    Attribute("wall_mass", float, "top-wall mass per unit depth M_w [M L-1]"),
+    Attribute("wall_mass", float, "top-wall mass M_w: per unit depth in 2-D [M L-1], in 3-D "
+              "[M]"),
     Attribute("sigma_beta", float, "lower turning point of the steady law [M L-1 T-2]; NaN "
               "without"),
     Attribute("sigma_alpha", float, "upper turning point of the steady law [M L-1 T-2]; NaN "

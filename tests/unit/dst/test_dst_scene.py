@@ -85,3 +85,29 @@ def test_dispatch_between_the_solvers(tmp_path):
 def test_shipped_examples_are_valid(name):
     scene = load_any_scene(ROOT / "config" / "scenes" / name)
     assert isinstance(scene, DSTScene) and scene.geometry.n_y == 20
+
+
+def test_shipped_3d_example_is_valid():
+    scene = load_any_scene(ROOT / "config" / "scenes" / "dst_stress_couette_3d.yaml")
+    geo = scene.geometry
+    assert scene.dimension == 3 and (geo.n_x, geo.n_y, geo.n_z) == (13, 8, 13)
+
+
+def test_three_dimensional_scene_sets_the_z_lattice():
+    scene = dst_scene_from_dict(dict(MINIMAL, dimension=3, box=[1.0, 1.0, 0.75]))
+    geo = scene.geometry
+    assert scene.dimension == geo.dimension == 3 and scene.box == (1.0, 1.0, 0.75)
+    assert (geo.n_x, geo.n_y, geo.n_z, geo.depth) == (20, 20, 15, pytest.approx(0.75))
+    assert dst_scene_from_dict(MINIMAL).geometry.n_z is None
+
+
+@pytest.mark.parametrize("dimension, box, key, words", [
+    (3, [1.0, 1.0], r"\[key 'box'\]", "a 3-D scene needs 3 box lengths (x, y, z), got 2"),
+    (2, [1.0, 1.0, 1.0], r"\[key 'box'\]", "a 2-D scene needs 2 box lengths (x, y), got 3"),
+    (3, [1.0, 1.0, 0.73], r"\[key 'box\[2\]'\]", "not a whole number of lattice spacings"),
+    (3, [1.0, 1.0, 0.5], r"\[key 'box\[2\]'\]", "periodic direction needs at least 13"),
+])
+def test_bad_box_names_the_key(dimension, box, key, words):
+    with pytest.raises(InputError, match=key) as error:
+        dst_scene_from_dict(dict(MINIMAL, dimension=dimension, box=box))
+    assert words in str(error.value)

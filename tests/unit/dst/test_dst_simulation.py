@@ -1,5 +1,6 @@
 """DSTSimulation: microstructure relaxation, walls, smoke runs of both flows, error paths."""
 import math
+import os
 
 import numpy as np
 import pytest
@@ -8,6 +9,7 @@ from suspsim.dst import (Channel, DSTSimulation, Geometry, Numerics, StressCouet
                          WyartCatesFluid)
 from suspsim.errors import InputError, NumericalError
 
+REDUCED = os.environ.get("SUSPSIM_REDUCED") == "1"
 DST_FLUID = dict(eta_s=1.0, phi=0.54, phi_m=0.562, phi_0=0.693, sigma_star=1.0, beta=2.0,
                  K_f=1.0, alpha=0.0)
 
@@ -31,14 +33,19 @@ def test_relaxation_ode_under_uniform_shear():
     assert means[-1] < 0.9 - 0.8 * (0.9 - f_hat)  # most of the way relaxed
 
 
-def test_walls_stop_particles_moving_into_them():
-    """No penetration: fluid pushed at the bottom wall at Mach 0.05 stays inside 0 < y < L_y."""
+@pytest.mark.parametrize("dimension", [2, pytest.param(3, marks=pytest.mark.slow)])
+def test_walls_stop_particles_moving_into_them(dimension):
+    """No penetration: fluid pushed at the bottom wall at Mach 0.05 stays inside 0 < y < L_y
+    (3D: 13 × 12 × 13, slow)."""
     fluid = WyartCatesFluid.newtonian(1.0)
-    sim = DSTSimulation(fluid, Channel(1e-12), Geometry(14, 12, 1.0),
+    geometry = Geometry(14, 12, 1.0) if dimension == 2 else Geometry(13, 12, 1.0, n_z=13)
+    sim = DSTSimulation(fluid, Channel(1e-12), geometry,
                         Numerics(density=1.0, sound_speed=20.0, max_density_error=0.2),
                         threads=1)
     nf = sim.n_fluid
-    sim.set_state(velocity=np.column_stack([np.zeros(nf), np.full(nf, -1.0)]))
+    velocity = np.zeros((nf, dimension))
+    velocity[:, 1] = -1.0
+    sim.set_state(velocity=velocity)
     momentum0 = sim.snapshot()["v_y"].sum()
     while sim.time < 0.6:
         sim.advance(100)
@@ -110,24 +117,27 @@ def test_blow_up_names_the_setting():
         sim.advance(5000)
 
 
-def _colour_gradient_after(shifting):
+def _colour_gradient_after(shifting, dimension, steps):
     fluid = WyartCatesFluid.newtonian(1.0)
-    sim = DSTSimulation(fluid, Channel(50.0), Geometry(14, 12, 1.0),
+    geometry = Geometry(14, 12, 1.0) if dimension == 2 else Geometry(13, 12, 1.0, n_z=13)
+    sim = DSTSimulation(fluid, Channel(50.0), geometry,
                         Numerics(density=1.0, shifting=shifting), threads=1)
     rng = np.random.default_rng(11)
-    pos = sim.snapshot()
-    jitter = 0.15 * sim.geometry.spacing * rng.uniform(-1, 1, (sim.n_fluid, 2))
-    sim.set_state(positions=np.column_stack([pos["x"], pos["y"]]) + jitter)
+    jitter = 0.15 * sim.geometry.spacing * rng.uniform(-1, 1, (sim.n_fluid, dimension))
+    sim.set_state(positions=sim.positions_all[:sim.n_fluid] + jitter)
     before = np.sqrt(np.mean(np.sum(sim.rates()["colour_gradient"] ** 2, axis=1)))
-    sim.advance(1500)
+    sim.advance(steps)
     after = np.sqrt(np.mean(np.sum(sim.rates()["colour_gradient"] ** 2, axis=1)))
     return before, after, sim
 
 
-def test_particle_shifting_is_switchable_and_regularises():
-    """Lind shifting (δx = −A h |v| δt ∇C) evens out a jittered start faster than advection."""
-    before, plain, sim_plain = _colour_gradient_after(False)
-    _, shifted, sim_shift = _colour_gradient_after(True)
+@pytest.mark.parametrize("dimension, steps", [
+    (2, 1500), pytest.param(3, 500 if REDUCED else 1500, marks=pytest.mark.slow)])
+def test_particle_shifting_is_switchable_and_regularises(dimension, steps):
+    """Lind shifting (δx = −A h |v| δt ∇C) evens out a jittered start faster than advection
+    (3D: 13 × 12 × 13, slow; 500 steps reduced)."""
+    before, plain, sim_plain = _colour_gradient_after(False, dimension, steps)
+    _, shifted, sim_shift = _colour_gradient_after(True, dimension, steps)
     assert shifted < 0.7 * plain
     assert shifted < before
     assert np.all(np.isfinite(sim_shift.snapshot()["v_x"]))
