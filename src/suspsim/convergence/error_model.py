@@ -89,6 +89,9 @@ FIXED = {"kernel": "lucy", "jitter": 0.1}
 #: Fraction of the tolerance the inflated expected error may use [choice: room for the scatter
 #: of a new case beyond the training envelope].
 SAFETY = 0.8
+#: A training run measured above this multiple of the first fit is left out of the fit and
+#: caps the domain's time step [choice].
+OUTLIER_RATIO = 3.0
 #: Expectile of the asymmetric least-squares fit [choice].
 EXPECTILE = 0.9
 #: Exponent grids of the fit.
@@ -251,7 +254,7 @@ class ErrorModel:
 def _bounded(d: Drivers) -> dict[str, float]:
     """The drivers whose measured range limits the model, keyed as in ``bounds``."""
     out = {f"resolution_{d.dimension}d": d.resolution, f"inverse_length_{d.flow}": 1 / d.length,
-           "wi": d.wi, "courant": d.courant}
+           "wi": d.wi, f"courant_{d.dimension}d": d.courant}
     if d.units > 0:
         out["units"] = d.units
     return out
@@ -279,9 +282,11 @@ def load_model(path: str | None = None) -> ErrorModel:
 
 
 def training_points(datasets: Sequence[xr.Dataset]) -> list[tuple[Drivers, float, float]]:
-    """(drivers, measured error bound [1], CPU time [s]) of every finished configuration in the
-    modelled domain (lucy, jitter 0.1, Wi ≤ 0.01 and ≥ 1e-3, q outside the gap, Couette with
-    ≥ 2 averaged units so a standard error exists)."""
+    """(drivers, measured error bound [1], CPU time [s]) of every configuration in the
+    modelled domain (lucy, jitter 0.1, 1e-3 ≤ Wi ≤ 0.01, q on the grid's range and outside
+    the gap, Couette with ≥ 2 averaged units so a standard error exists); a run that blew up
+    has NaN bound and cost (none in this domain so far: the blow-ups were at q ≤ 1.2 in 3D,
+    Wi = 0.03 and the quintic kernel)."""
     out = []
     for ds in datasets:
         case = get_case(ds.attrs["case"])
@@ -290,15 +295,14 @@ def training_points(datasets: Sequence[xr.Dataset]) -> list[tuple[Drivers, float
         for i in range(ds.sizes["configuration"]):
             row = ds.isel(configuration=i)
             bound, cpu = float(row["error_bound"]), float(row["cpu_time"])
-            if not (np.isfinite(bound) and np.isfinite(cpu)):
-                continue
             settings = {a.name: _value(row[a.name].item(), a.default) for a in case.axes}
             if any(settings[k] != v for k, v in FIXED.items()):
                 continue
             if not GRID["wi_target"][0] <= settings["wi_target"] <= GRID["wi_target"][-1]:
                 continue
             d = drivers(case.build(settings), settings)
-            if RESOLUTION_GAP[0] < d.resolution < RESOLUTION_GAP[1]:
+            if (RESOLUTION_GAP[0] < d.resolution < RESOLUTION_GAP[1]
+                    or d.resolution < 0.9 * min(GRID["resolution"][d.dimension])):
                 continue
             if d.flow == "couette" and d.units < 2:
                 continue
@@ -337,32 +341,56 @@ def fit_coefficients(points: Sequence[tuple[Drivers, float]], exponents: Mapping
     return dict(zip(names, map(float, coef))), loss
 
 
-def fit(datasets: Sequence[xr.Dataset], provenance: Mapping[str, Any] | None = None
-        ) -> ErrorModel:
-    """The error and cost models fitted on ``datasets`` (case files of :mod:`.study`)."""
-    points = training_points(datasets)
-    if len(points) < 8:
-        raise InputError("error model", f"{len(points)} usable measurements; need at least 8")
-    pairs = [(d, bound) for d, bound, _ in points]
+def _fit_exponents(pairs: Sequence[tuple[Drivers, float]]
+                   ) -> tuple[dict[str, float], dict[str, float], float]:
     best = None
     for combo in itertools.product(*EXPONENTS.values()):
         exponents = dict(zip(EXPONENTS, combo))
-        coef, sse = fit_coefficients(pairs, exponents)
-        if best is None or sse < best[2]:
-            best = (coef, exponents, sse)
-    coef, exponents, sse = best
+        coef, loss = fit_coefficients(pairs, exponents)
+        if best is None or loss < best[2]:
+            best = (coef, exponents, loss)
+    return best
+
+
+def fit(datasets: Sequence[xr.Dataset], provenance: Mapping[str, Any] | None = None
+        ) -> ErrorModel:
+    """The error and cost models fitted on ``datasets`` (case files of :mod:`.study`).
+
+    A run that blew up inside the domain, or whose measured bound exceeds
+    :data:`OUTLIER_RATIO` × the first fit, is left out of the fit and caps the time step: the
+    domain's C_Δx (per dimension) stops below the smallest C_Δx of such runs (a measured
+    stability/accuracy bound)."""
+    points = training_points(datasets)
+    finished = [(d, bound, cpu) for d, bound, cpu in points
+                if math.isfinite(bound) and math.isfinite(cpu)]
+    if len(finished) < 8:
+        raise InputError("error model", f"{len(finished)} usable measurements; need at least 8")
+    coef, exponents, _ = _fit_exponents([(d, b) for d, b, _ in finished])
+    first = ErrorModel(coef, exponents, 1.0, {}, {})
+    unsafe: dict[int, float] = {}
+    inliers = []
+    for d, bound, cpu in points:
+        if math.isfinite(bound) and bound <= OUTLIER_RATIO * sum(first.terms(d).values()):
+            inliers.append((d, bound, cpu))
+        else:
+            unsafe[d.dimension] = min(unsafe.get(d.dimension, math.inf), d.courant)
+    pairs = [(d, bound) for d, bound, _ in inliers]
+    coef, exponents, loss = _fit_exponents(pairs)
     model = ErrorModel(coef, exponents, 1.0, {}, {})
     ratios = np.array([bound / sum(model.terms(d).values()) for d, bound in pairs])
     model.inflation = float(max(1.0, ratios.max()))
-    model.residuals = {"n_points": len(pairs), "rms_relative": math.sqrt(sse / len(pairs)),
-                       "median_ratio": float(np.median(ratios)),
+    model.residuals = {"n_points": len(pairs), "n_left_out": len(points) - len(pairs),
+                       "weighted_loss": loss, "median_ratio": float(np.median(ratios)),
                        "max_ratio": float(ratios.max()), "min_ratio": float(ratios.min())}
-    for d, _, _ in points:
+    for d, _ in pairs:
+        if d.courant >= unsafe.get(d.dimension, math.inf):
+            continue
         for name, value in _bounded(d).items():
             lo, hi = model.bounds.get(name, [math.inf, -math.inf])
             model.bounds[name] = [min(lo, value), max(hi, value)]
-    model.cost = fit_cost([(d, cpu) for d, _, cpu in points])
-    model.provenance = dict(provenance or {})
+    model.cost = fit_cost([(d, cpu) for d, _, cpu in inliers])
+    model.provenance = {**dict(provenance or {}),
+                        "unsafe_courant": {f"{k}d": v for k, v in unsafe.items()}}
     return model
 
 
