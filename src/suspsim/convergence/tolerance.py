@@ -94,7 +94,8 @@ def scene_case(scene: Scene) -> Case:
                    "number_density": q ** dim,
                    "fluid": {"law": scene.fluid.law.name, "params": _scaled_params(scene, factor)}}
             strain = float(settings["transient"]) + int(settings["units"])
-            out["run"].update(strain=strain, time=None, transient=float(settings["transient"]),
+            out["run"].pop("time", None)
+            out["run"].update(strain=strain, transient=float(settings["transient"]),
                               output_interval=min(out["run"]["output_interval"], 0.1))
             return out
     else:
