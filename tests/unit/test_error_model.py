@@ -19,7 +19,8 @@ from test_run_loop import FakeSimulation
 
 EXPONENTS = {"p_2d": 2.0, "p_3d": 1.5, "r": 2.5, "s": 2.0}
 TRUE = {"disc_stress_3d": 0.02, "disc_profile_3d": 0.03, "flow_poiseuille": 0.4,
-        "flow_couette": 0.0, "wi": 0.5, "courant_3d": 0.01, "stat_3d": 0.002}
+        "flow_couette": 0.0, "wi": 0.5, "courant_3d": 0.01, "stat_3d": 0.002,
+        "yield_poiseuille": 0.003}
 
 
 def synthetic_points(rng):
@@ -29,7 +30,9 @@ def synthetic_points(rng):
         flow = rng.choice(["couette", "poiseuille"])
         d = em.Drivers(flow, 3, rng.uniform(1.5, 3.5), rng.uniform(2.0, 10.0),
                        10 ** rng.uniform(-3, -2), rng.uniform(0.05, 1.0),
-                       float(rng.integers(2, 7)) if flow == "couette" else 0.0, 1000, 1000)
+                       float(rng.integers(2, 7)) if flow == "couette" else 0.0, 1000, 1000,
+                       0.0 if flow == "couette" else rng.uniform(0.0, 5.0), 0 if flow == "couette"
+                       else 2 * int(rng.integers(5, 20)))
         model = em.ErrorModel(TRUE, EXPONENTS, 1.0, {}, {})
         points.append((d, sum(model.terms(d).values())))
     return points
@@ -207,3 +210,52 @@ def test_cli_tolerance_unreachable_exits_1(tmp_path, capsys):
                  "--tolerance", "1e-5"]) == 1
     assert "not reachable" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_study_tolerance_key_adds_the_picked_configuration():
+    from suspsim.convergence.study import configurations
+
+    case = get_case("couette_newtonian_3d")
+    picked = em.pick(case, 0.05).settings
+    defaults = case.settings()
+    out = configurations(case, {"tolerance": [0.05], "side": [10.0]})
+    assert {k: v for k, v in picked.items() if v != defaults[k]} in out
+    assert {"side": 10.0} in out and {} in out
+    with pytest.raises(InputError, match="not reachable"):
+        configurations(case, {"tolerance": [1e-5]})
+
+
+def test_split_force_channel_needs_even_rows():
+    """Odd row counts across L_y put a row on the force's sign change (module docstring)."""
+    base = dict(flow="poiseuille", dimension=2, resolution=3.0, length=3.0, wi=1e-3,
+                courant=0.1, units=0.0, n_particles=100, n_steps=100)
+    assert em.regular(em.Drivers(**base, rows=30))
+    assert not em.regular(em.Drivers(**base, rows=15))
+    assert em.regular(em.Drivers(**{**base, "flow": "couette"}, rows=0))
+    assert not em.regular(em.Drivers(**{**base, "resolution": 2.0}, rows=30))
+    case = get_case("poiseuille_newtonian_2d")
+    settings = case.settings({"resolution": 3.0, "width": 2.5})     # 15 rows across L_y = 5 h
+    assert not em.regular(em.drivers(case.build(settings), settings))
+
+
+def test_timestep_outlier_caps_the_domain():
+    """A run far above the model whose geometry ran well at a smaller step caps C_Δx."""
+    rng = np.random.default_rng(4)
+    points = synthetic_points(rng)
+    d0 = next(d for d, _ in points if d.flow == "couette")
+    model = em.ErrorModel(TRUE, EXPONENTS, 1.0, {}, {})
+    calm = em.Drivers(**{**d0.__dict__, "courant": 0.1})
+    wild = em.Drivers(**{**d0.__dict__, "courant": 0.9})
+    records = points + [(calm, sum(model.terms(calm).values())),
+                        (wild, 20 * sum(model.terms(wild).values()))]
+
+    fake_points = [(d, b, 1e-6 * d.work) for d, b in records]
+    original = em.training_points
+    try:
+        em.training_points = lambda datasets: fake_points
+        fitted = em.fit([])
+    finally:
+        em.training_points = original
+    assert fitted.provenance["unsafe_courant"] == {"couette_3d": pytest.approx(0.9)}
+    assert fitted.bounds["courant_couette_3d"][1] < 0.9
+    assert fitted.inflation < 1.5
