@@ -256,6 +256,15 @@ def test_timestep_outlier_caps_the_domain():
         fitted = em.fit([])
     finally:
         em.training_points = original
-    assert fitted.provenance["unsafe_courant"] == {"couette_3d": pytest.approx(0.9)}
-    assert fitted.bounds["courant_couette_3d"][1] < 0.9
+    assert fitted.provenance["unsafe_courant"] == {"couette_newtonian_3d": pytest.approx(0.9)}
+    assert fitted.bounds["courant_couette_newtonian_3d"][1] < 0.9
     assert fitted.inflation < 1.5
+
+
+def test_rate_dependent_law_gets_its_own_time_step_range():
+    """The example Papanastasiou Couette (viscous-limited, Re_p 0.007): C_ν = 0.2 measured 21 %
+    off, 0.1 within 0.7 %; the picker must stay in the rate-dependent law's measured range."""
+    chosen, choice, _ = choose(scene_from_dict(COUETTE), 0.05)
+    model = em.load_model()
+    assert choice.drivers.courant <= model.bounds["courant_couette_rate_dependent_3d"][1]
+    assert choice.settings["dt_coefficient"] <= 0.1

@@ -4,15 +4,20 @@ and costs at most 2× the cheapest configuration that meets it among the candida
 judged cheaper (suspsim.convergence.holdout).
 
 Slow; ``SUSPSIM_REDUCED=1`` (CI) compares with at most 3 runs per case instead of 6 and skips
-the Bingham channel (about a minute of CPU). Measured on 2026-12-03 with
-``python -m suspsim.convergence.holdout CASE TOL OUT.nc 6`` (docs/figures/error_model/):
-couette_papanastasiou_bn99_3d meets 5 % and 2 % at the cheapest configuration (bound 0.58 %);
-poiseuille_newtonian_2d at 5 % picks q = 2.5, which blew up in the 2D channel (the model had no
-2D channel data: its 2D resolutions come from Couette, where q = 2.5 is accurate);
-poiseuille_bingham10_3d at 5 % measured 7.8 % against 3.4 % expected (the flow-resolution term
-fitted on Bn = 1 misses the Bn = 10 channel's error, which barely falls with W: 8.9 % at W = 7.5
-h, 7.8 % at 10 h). Those two report xfail with their reason while they fail; a fix belongs in
-the model (more training flows), not in this test.
+the Bingham channel at 5 % (a few minutes of CPU). Measured on 2026-12-03 with
+``sh docs/figures/error_model/run_holdout.sh`` (CPU seconds of one thread; the model fitted on
+the five training cases of ``error_model.json``):
+
+- couette_papanastasiou_bn99_3d, 5 % and 2 %: picks the cheapest grid point (q = 1.6, side
+  5 h), bound 0.58 % (expected 1.26 %), cost ratio 1;
+- poiseuille_newtonian_2d, 10 %: bound 1.6 % (expected 6.2 %), ratio 1; 5 %: bound 0.22 %
+  (expected 3.9 %) at 0.49 s, but q = 3, W = 3.75 h met it at 0.19 s: ratio 2.6, a fail of the
+  cost criterion (the model over-predicts the 2D channel, which it never saw, by 4-17×);
+- poiseuille_bingham10_3d, 10 %: bound 8.9 % (expected 8.0 %), ratio 1; 5 %: see the report
+  in docs/figures/error_model/run_holdout.log.
+
+The cost failure reports xfail with its reason while it fails; a fix belongs in the model
+(training data of the flow), not in this test.
 """
 import os
 
@@ -26,10 +31,12 @@ MAX_RUNS = 3 if REDUCED else 6
 CASES = [
     ("couette_papanastasiou_bn99_3d", 0.05, None),
     ("couette_papanastasiou_bn99_3d", 0.02, None),
-    ("poiseuille_newtonian_2d", 0.05, "picks q = 2.5, which blows up in the 2D channel"),
-    pytest.param("poiseuille_bingham10_3d", 0.05,
-                 "measured 7.8 % against 3.4 % expected at Bn = 10",
-                 marks=pytest.mark.skipif(REDUCED, reason="about a minute of CPU")),
+    ("poiseuille_newtonian_2d", 0.1, None),
+    ("poiseuille_newtonian_2d", 0.05, "2.6x the cheapest: the model over-predicts the 2D "
+                                      "channel at W = 3.75 h (1.6 % measured)"),
+    ("poiseuille_bingham10_3d", 0.1, None),
+    pytest.param("poiseuille_bingham10_3d", 0.05, "see docs/figures/error_model/run_holdout.log",
+                 marks=pytest.mark.skipif(REDUCED, reason="a few minutes of CPU")),
 ]
 
 
