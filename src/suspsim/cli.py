@@ -1,7 +1,8 @@
 """The ``suspsim`` command line: ``suspsim fit FILE [--law NAME|auto] [--sample ID] [--out F] [--plot F]``.
 
-Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N]`` (an SPH run, see
-:mod:`suspsim.run`, or a DST run of a wyart_cates scene, see :mod:`suspsim.dst.run`),
+Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N] [--tolerance EPS]`` (an SPH
+run, see :mod:`suspsim.run`, or a DST run of a wyart_cates scene, see :mod:`suspsim.dst.run`;
+``--tolerance`` chooses the numerics from the error model, :mod:`suspsim.convergence.tolerance`),
 ``suspsim bench [--scene NAME] [--threads N] [--steps K] [--json]`` and
 ``suspsim pack --shape sphere|sand --phi PHI --radius A --box LX LY LZ --out PACK.nc
 [--polydispersity S] [--seed N] ...`` (a random packing, see :mod:`suspsim.bodies.packing`).
@@ -59,6 +60,11 @@ def _build_parser() -> argparse.ArgumentParser:
                      "its checkpoint")
     run.add_argument("--threads", type=_positive_int, help="worker threads (default: the "
                      "scene's run.threads)")
+    run.add_argument("--tolerance", type=float, help="relative error to meet: the scene gives "
+                     "the physics, the measured error model chooses resolution, time step, "
+                     "sound speed, box side or channel width and averaging at least expected "
+                     "cost (SPH fluid couette/poiseuille scenes; see "
+                     "suspsim.convergence.tolerance)")
 
     bench = sub.add_parser("bench", help="measure the solver's speed on standard scenes")
     bench.add_argument("--scene", choices=BENCH_SCENES, help="one scene (default: all)")
@@ -130,7 +136,19 @@ def _cmd_run(args) -> int:
     from .scene import Scene, load_any_scene
 
     scene = load_any_scene(args.scene)
-    if isinstance(scene, Scene):
+    if args.tolerance is not None:
+        from .convergence.tolerance import SUPPORTED, choose
+        from .run import run_scene
+
+        if not isinstance(scene, Scene):
+            raise InputError(args.scene, SUPPORTED)
+        scene, choice, attrs = choose(scene, args.tolerance)
+        print(f"tolerance {args.tolerance:g}: {attrs['tolerance_settings']}; expected error "
+              f"{choice.expected_error:.3g}, expected cost {choice.expected_cost:.3g} s CPU "
+              f"({choice.drivers.n_particles} particles, {choice.drivers.n_steps} steps)")
+        out = run_scene(scene, args.out, resume=args.resume, threads=args.threads,
+                        extra_attrs=attrs)
+    elif isinstance(scene, Scene):
         from .run import run_scene
 
         out = run_scene(scene, args.out, resume=args.resume, threads=args.threads)

@@ -156,10 +156,12 @@ class Record:
 
 def run_scene(scene: Scene | str | PathLike, out_path: str | PathLike, *, resume: bool = False,
               threads: int | None = None, progress: ProgressReporter | None = None,
-              simulation_factory=None, clock=time.monotonic) -> Path:
+              simulation_factory=None, clock=time.monotonic,
+              extra_attrs: dict[str, Any] | None = None) -> Path:
     """Run ``scene`` (a Scene or a scene file) to the end and write ``out_path``; return it.
 
-    ``threads`` overrides ``run.threads``; ``progress`` defaults to a reporter on stderr;
+    ``threads`` overrides ``run.threads``; ``extra_attrs`` are added to the output's run
+    attributes (registry names, e.g. the tolerance set-up of :mod:`suspsim.convergence.tolerance`); ``progress`` defaults to a reporter on stderr;
     ``simulation_factory`` is the Simulation class (default :mod:`suspsim.sph.simulation`),
     called as ``factory(scene, threads=)`` or ``factory.from_state(scene, state, threads=)``.
     Raises InputError (unusable scene, checkpoint missing or of another scene, a stale
@@ -190,7 +192,7 @@ def run_scene(scene: Scene | str | PathLike, out_path: str | PathLike, *, resume
             record.add_profiles(sim.profiles(scene.run.profile_bins))
 
     wall = drive(sim, record, plan, take_sample, segment)
-    _write_output(out, scene, sim, record, plan, wall)
+    _write_output(out, scene, sim, record, plan, wall, extra_attrs or {})
     ckpt.unlink(missing_ok=True)
     return out
 
@@ -327,7 +329,8 @@ def _failure(message: str, where: str, ckpt: Path, *,
     return NumericalError(f"{message} [{where}{note}]; {kept}")
 
 
-def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall: float) -> None:
+def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall: float,
+                  extra_attrs: dict[str, Any]) -> None:
     series = record.arrays()
     data: dict[str, Any] = {"time": series["time"], **{k: series[k] for k in SAMPLE_NAMES}}
     if scene.flow.type == "couette":
@@ -356,6 +359,7 @@ def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall
              "dt": sim.dt, "sound_speed": sim.sound_speed}
     if getattr(sim, "bodies", None) is not None:
         attrs.update(n_bodies=sim.bodies.count, n_body_particles=sim.n_body_particles)
+    attrs.update(extra_attrs)
     write_run(out, data, attrs, scene)
     log.info("wrote %s (Re %.3g, max Mach %.3g)", out, attrs["reynolds_number"],
              attrs["mach_number"])

@@ -51,10 +51,16 @@ MEASURED = {
 
 def configurations(case: AnyCase, values: Mapping[str, Sequence[Any]],
                    sweep: str = "one_at_a_time") -> list[dict[str, Any]]:
-    """The overrides of each configuration (``{}`` is the case's defaults), without repeats."""
+    """The overrides of each configuration (``{}`` is the case's defaults), without repeats.
+
+    ``tolerance: [ε, ...]`` among the values adds, for each ε, the configuration the error
+    model's picker chooses for that relative error (:func:`.error_model.pick`; an unreachable
+    ε is an InputError), so a study measures what ``suspsim run --tolerance`` would run."""
     if sweep not in SWEEPS:
         raise InputError("speed_error", f"sweep must be one of {', '.join(SWEEPS)}, not '{sweep}'",
                          key="speed_error.sweep")
+    values = dict(values)
+    tolerances = values.pop("tolerance", [])
     defaults = case.settings()
     for axis in values:
         case.settings({axis: defaults.get(axis)})
@@ -63,6 +69,10 @@ def configurations(case: AnyCase, values: Mapping[str, Sequence[Any]],
         combos = [dict(zip(axes, combo)) for combo in itertools.product(*values.values())]
     else:
         combos = [{}] + [{axis: value} for axis, listed in values.items() for value in listed]
+    if tolerances:
+        from suspsim.convergence.error_model import pick
+
+        combos += [pick(case, float(tol)).settings for tol in tolerances]
     out, seen = [], set()
     for combo in combos:
         overrides = {k: v for k, v in combo.items() if v != defaults[k]}

@@ -125,6 +125,19 @@ RUN_ATTRIBUTES: Mapping[str, Attribute] = MappingProxyType({a.name: a for a in (
     Attribute("completed", int, "1 if the run reached its end, 0 if it stopped early"),
     Attribute("dt", float, "time step used [tau]"),
     Attribute("sound_speed", float, "sound speed c used [h/tau]"),
+    Attribute("tolerance", float, "requested relative error of suspsim run --tolerance [1]"),
+    Attribute("expected_error", float, "error model's expected error bound (error + 2 "
+              "standard errors) of the chosen set-up [1]"),
+    Attribute("expected_cost_s", float, "cost model's expected CPU time of one thread [s]"),
+    Attribute("tolerance_settings", str, "numerical settings chosen for the tolerance (JSON: "
+              "resolution h/dx [1], dt_coefficient [1], wi_target [1], side or width [h], "
+              "units [strain], kernel, jitter [spacings])"),
+    Attribute("tolerance_error_terms", str, "error model contributions of the chosen set-up "
+              "(JSON, each [1], before the inflation factor)"),
+    Attribute("tolerance_stress_scale", float, "factor applied to the scene's stress-like law "
+              "parameters (and so to output stresses and viscosities) by the rescaling [1]"),
+    Attribute("error_model", str, "provenance of the error model (JSON: datasets, date, "
+              "command, inflation)"),
     Attribute("n_bodies", int, "number of rigid inclusions"),
     Attribute("n_body_particles", int, "SPH particles in the bodies' surface shells"),
 )})

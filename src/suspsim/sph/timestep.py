@@ -27,9 +27,11 @@ g body acceleration [h τ^−2]; L_y box height [h]; h support radius (1 in scen
 """
 from __future__ import annotations
 
+import functools
 import math
 
 from suspsim.reference.poiseuille import poiseuille_profile
+from suspsim.rheology.laws import make_law
 from suspsim.scene import Scene
 
 #: Target Mach number of the velocity scale (Morris et al. 1997) [choice].
@@ -55,9 +57,16 @@ def velocity_scale(scene: Scene) -> float:
     if scene.flow.type == "couette":
         rate = scene.flow.shear_rate
         return rate * (0.5 * scene.box[1] if scene.run.start == "rest" else SUPPORT)
-    half = 0.5 * scene.box[1]
-    return float(poiseuille_profile(scene.fluid.law, scene.density * scene.flow.body_force, half,
-                                    0.5 * half))
+    law = scene.fluid.law
+    return _centre_velocity(law.name, tuple(sorted(law.params.items())),
+                            scene.density * scene.flow.body_force, 0.5 * scene.box[1])
+
+
+@functools.lru_cache(maxsize=256)
+def _centre_velocity(law: str, params: tuple, force_density: float, half: float) -> float:
+    """Centre-line velocity [h τ^-1] of the half-channel ``half`` [h] (cached: the quadrature
+    is slow and the error model's picker asks for it once per candidate time step)."""
+    return float(poiseuille_profile(make_law(law, dict(params)), force_density, half, 0.5 * half))
 
 
 def auto_sound_speed(scene: Scene) -> float:
