@@ -161,7 +161,8 @@ def run_scene(scene: Scene | str | PathLike, out_path: str | PathLike, *, resume
     """Run ``scene`` (a Scene or a scene file) to the end and write ``out_path``; return it.
 
     ``threads`` overrides ``run.threads``; ``extra_attrs`` are added to the output's run
-    attributes (registry names, e.g. the tolerance set-up of :mod:`suspsim.convergence.tolerance`); ``progress`` defaults to a reporter on stderr;
+    attributes (registry names, e.g. the tolerance set-up of
+    :mod:`suspsim.convergence.tolerance`); ``progress`` defaults to a reporter on stderr;
     ``simulation_factory`` is the Simulation class (default :mod:`suspsim.sph.simulation`),
     called as ``factory(scene, threads=)`` or ``factory.from_state(scene, state, threads=)``.
     Raises InputError (unusable scene, checkpoint missing or of another scene, a stale
