@@ -213,3 +213,22 @@ def test_a_suspension_run_goes_through_pack_and_simulate(tmp_path):
         assert run.attrs["inclusion_shape"] == "sphere"
         assert json.loads(run.attrs["scene"])["inclusions"]["packing"] == (
             "results/linear_polymer/packings/phi-0.1_seed-1.nc")
+
+
+def test_sand_study_packs_sand_grains_for_each_phi(tmp_path):
+    study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
+    sand = ["--configfile", "config/studies/sand.yaml"]
+    dry = _run(study, "-n", *sand)
+    assert dry.returncode == 0, dry.stderr
+    config = yaml.safe_load((study / "config/studies/sand.yaml").read_text())["simulation"]
+    phis = [phi for phi in config["volume_fractions"] if phi > 0]
+    assert sorted(job["phi"] for job in _dry_jobs(dry, "pack")) == [f"{p:g}" for p in phis]
+    assert len(_dry_jobs(dry, "simulate")) == (len(config["volume_fractions"])
+                                               * len(config["shear_rates"]))
+    packing = "results/linear_polymer/packings/phi-0.1_seed-1.nc"
+    assert _run(study, packing, *sand).returncode == 0
+    with xr.open_dataset(study / packing) as pack:
+        assert pack.attrs["shape"] == "sand" and list(pack.attrs["box"]) == [17.0] * 3
+        # grains reach out to 1.6 volume-equivalent radii: the 17 h box holds them
+        assert float(pack["support_radius"].max()) <= 1.6 * 2.5 + 1e-9
+        assert pack.sizes["body"] >= 1
