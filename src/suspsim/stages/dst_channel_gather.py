@@ -25,6 +25,7 @@ from ..io.atomic import atomic_path, save_figure
 from ..io.provenance import provenance
 from ..plotting.dst_channel import plot_channel_flow, plot_channel_profiles
 from .dst_channel import encoding
+from .dst_gather import load_runs
 
 log = logging.getLogger(__name__)
 
@@ -58,13 +59,7 @@ def write_channel_sets(run_files: Mapping[str, Sequence[str | os.PathLike]],
     group of global attributes (``groups`` lists the sets) and one group per set."""
     datasets = {}
     for name, files in run_files.items():
-        runs = []
-        for path in files:
-            try:
-                runs.append(xr.load_dataset(path))
-            except (OSError, ValueError) as err:
-                raise InputError(str(path), f"cannot read the channel run: {err}") from err
-        datasets[name] = gather_channel_set(runs, [str(p) for p in files])
+        datasets[name] = gather_channel_set(load_runs(files), [str(p) for p in files])
     write_groups(out_nc, datasets, command=command)
     log.info("wrote %s: %s", out_nc, ", ".join(f"{n} ({d.sizes['force_ratio']} forces)"
                                                for n, d in datasets.items()))

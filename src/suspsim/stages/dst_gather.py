@@ -323,7 +323,7 @@ def write_flow_curves(run_files: Sequence[str | os.PathLike], out_nc: str | os.P
                       band_files: Sequence[str | os.PathLike] = ()) -> None:
     """Gather ``run_files`` (study-point order) and ``band_files`` (band-point order) into
     ``out_nc`` atomically."""
-    runs, bands = _load(run_files), _load(band_files)
+    runs, bands = load_runs(run_files), load_runs(band_files)
     dataset = gather_flow_curves(runs, settings, sources=[str(p) for p in run_files],
                                  bands=bands, band_sources=[str(p) for p in band_files])
     encoding = {name: {"_FillValue": None} for name in dataset.coords
@@ -334,7 +334,8 @@ def write_flow_curves(run_files: Sequence[str | os.PathLike], out_nc: str | os.P
              dataset.attrs["wall_time_s"])
 
 
-def _load(paths) -> list[xr.Dataset]:
+def load_runs(paths) -> list[xr.Dataset]:
+    """Each run file loaded into memory; InputError naming the file it cannot read."""
     out = []
     for path in paths:
         try:
