@@ -116,6 +116,22 @@ def test_drivers_of_a_case_match_its_scene():
     assert abs(d.n_steps - 40000) <= 2
 
 
+
+def test_plug_time_step_term_only_in_yield_stress_channels():
+    case = get_case("poiseuille_bingham5_3d")
+    settings = case.settings({"dt_coefficient": 0.4, "width": 7.5})
+    d = em.drivers(case.build(settings), settings)
+    # Bn = 2ξ/(1 − ξ)² = 5 → 5ξ² − 12ξ + 5 = 0
+    xi = (12.0 - math.sqrt(44.0)) / 10.0
+    assert d.plug == pytest.approx(xi, rel=1e-6)
+    exponents = {"p_3d": 1.0, "r": 1.0, "s": 2.0, "t": 1.0}
+    plug_term = em._features(d, exponents)["courant_plug_3d"]
+    assert plug_term == pytest.approx(d.courant ** 2 * xi / (1.0 - xi), rel=1e-6)
+    newtonian = get_case("poiseuille_newtonian_3d")
+    d_newtonian = em.drivers(newtonian.build(newtonian.settings()), newtonian.settings())
+    assert d_newtonian.plug == 0.0
+    assert "courant_plug_3d" not in em._features(d_newtonian, exponents)
+
 COUETTE = {"dimension": 3, "box": [10, 10, 10], "number_density": 4.096,
            "fluid": {"law": "papanastasiou", "params": {"mu_pl": 10.0, "mu_0": 990.0, "M": 100.0}},
            "flow": {"type": "couette", "shear_rate": 0.1}, "run": {"strain": 12}}

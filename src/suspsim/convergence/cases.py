@@ -356,7 +356,8 @@ AnyCase = Case | DSTPointCase
 CASES: dict[str, AnyCase] = {case.name: case for case in (
     newtonian_couette(3), newtonian_couette(2), papanastasiou_couette(9.9, 3),
     papanastasiou_couette(99.0, 3), newtonian_poiseuille(3), newtonian_poiseuille(2),
-    bingham_poiseuille(1.0, 3), bingham_poiseuille(3.0, 3), bingham_poiseuille(10.0, 3),
+    bingham_poiseuille(1.0, 3), bingham_poiseuille(3.0, 3), bingham_poiseuille(5.0, 3),
+    bingham_poiseuille(10.0, 3),
     dst_flow_curve_point(0.54, 2.5),
     dst_flow_curve_point(0.50, 1.0))}
 

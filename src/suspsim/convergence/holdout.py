@@ -27,7 +27,7 @@ from suspsim.convergence.cases import Case, get_case
 from suspsim.convergence.error_model import ErrorModel, evaluate, load_model, pick
 from suspsim.convergence.measure import run_configuration
 from suspsim.convergence.study import case_dataset
-from suspsim.errors import NumericalError
+from suspsim.errors import InputError, NumericalError
 
 log = logging.getLogger(__name__)
 #: Largest allowed ratio of the picked run's cost to the cheapest one meeting the tolerance.
@@ -94,7 +94,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(__doc__.split("Command")[1], file=sys.stderr)
         return 1
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s")
-    ds = check(argv[0], float(argv[1]), max_runs=int(argv[3]) if len(argv) == 4 else 6)
+    try:
+        ds = check(argv[0], float(argv[1]), max_runs=int(argv[3]) if len(argv) == 4 else 6)
+    except InputError as err:
+        # the picker refuses (no modelled configuration meets the tolerance): nothing to run
+        print(f"error: {err}", file=sys.stderr)
+        return 1
     ds.attrs["command"] = "python -m suspsim.convergence.holdout " + " ".join(argv)
     ds.to_netcdf(argv[2])
     keys = ("tolerance", "expected_error", "expected_cost", "picked_error_bound",
