@@ -81,10 +81,14 @@ def _cross_velocities(snap):
     return max(np.abs(snap["v_y"]).max(), np.abs(snap.get("v_z", 0.0)).max())
 
 
-#: Lattice across the gap (reduced, full) per dimension: the 3D channel needs n_y = 20 for
-#: the 1 % (measured L2/peak 1.49 % at n_y = 12, 1.02 % at 16).
-CHANNEL_N_Y = {2: (20, 40), 3: (20, 24)}
-COUETTE_N_Y = {2: (16, 30), 3: (12, 16)}
+#: Lattice across the gap (reduced, full) per dimension. The 3D channel needs n_y = 20 for
+#: the 1 % (measured L2/peak 1.49 % at n_y = 12, 1.02 % at 16, 0.80 % at 20); the reduced 3D
+#: run (CI) is n_y = 12, a fifth of the cost (0.6 × the particles, 0.36 × the viscous steps),
+#: and checks that measured 1.49 % against 2 %: the 1 % bound is the full size's.
+CHANNEL_N_Y = {2: (20, 40), 3: (12, 24)}
+CHANNEL_BOUND = {(2, True): 0.01, (2, False): 0.01, (3, True): 0.02, (3, False): 0.01}
+#: The 3D stress Couette reads sigma_in/(V_w/L) 0.9938 at n_y = 8 (reduced) and 0.9939 at 12.
+COUETTE_N_Y = {2: (16, 30), 3: (8, 16)}
 
 
 @pytest.mark.parametrize("dimension", [2, 3])
@@ -109,7 +113,7 @@ def test_newtonian_channel_is_a_parabola(dimension):
     error = _l2_over_peak(snap["v_x"], exact)
     print(f"  L2/peak {error:.4f}, max cross-stream |v|/u_max "
           f"{_cross_velocities(snap) / 0.125:.2e}, fluid y within [{low:.4f}, {high:.4f}]")
-    assert error < 0.01
+    assert error < CHANNEL_BOUND[dimension, REDUCED]
     assert _cross_velocities(snap) < 1e-3 * 0.125
     assert 0.0 < low and high < 1.0
 
@@ -265,6 +269,7 @@ def split_run():
     return data, time.perf_counter() - start
 
 
+@pytest.mark.xdist_group("split_run")
 def test_zero_nonlocality_splits_onto_both_branches(split_run):
     """α = 0, φ = 0.54, σ_in = 2σ* (q = 0.39, on the unstable branch): stress splitting.
 
@@ -301,6 +306,7 @@ def test_zero_nonlocality_splits_onto_both_branches(split_run):
     "<psi1 - lever> = -0.031 +- 0.0053 (batch means), tolerance 3 se + 1 particle = 0.022. "
     "Reduced (14x10, strains 15-25): -0.020 +- 0.006 < 0.025 passes. psi1 still creeps up "
     "(0.64 at strain 20, 0.69 at 60), so the offset may be the unfinished drift; not resolved"))
+@pytest.mark.xdist_group("split_run")
 def test_zero_nonlocality_split_follows_the_lever_rule(split_run):
     """ψ1 agrees with the vertical-split lever rule at the measured common rate V_w/L_y:
     |⟨ψ1 − lever(V_w/L_y)⟩| < 3 standard errors (batch means of the per-sample difference, so

@@ -17,6 +17,8 @@ CHROMIUM = Path("/usr/bin/chromium")
 MATERIAL = "linear_polymer"
 SMOKE = ["--configfile", "config/studies/smoke.yaml"]
 WINDOW = (1400, 1000)
+# The module's tests share one smoke study and its report (a module fixture): one xdist worker.
+pytestmark = pytest.mark.xdist_group("report")
 
 # The report is a React app that opens on the rule graph and shows one result at a time, with no
 # URL to a result. This script, appended to a copy of the report, navigates as a reader does:

@@ -132,10 +132,10 @@ def _colour_gradient_after(shifting, dimension, steps):
 
 
 @pytest.mark.parametrize("dimension, steps", [
-    (2, 1500), pytest.param(3, 500 if REDUCED else 1500, marks=pytest.mark.slow)])
+    (2, 1500), pytest.param(3, 200 if REDUCED else 1500, marks=pytest.mark.slow)])
 def test_particle_shifting_is_switchable_and_regularises(dimension, steps):
     """Lind shifting (δx = −A h |v| δt ∇C) evens out a jittered start faster than advection
-    (3D: 13 × 12 × 13, slow; 500 steps reduced)."""
+    (3D: 13 × 12 × 13, slow; 200 steps reduced)."""
     before, plain, sim_plain = _colour_gradient_after(False, dimension, steps)
     _, shifted, sim_shift = _colour_gradient_after(True, dimension, steps)
     assert shifted < 0.7 * plain
