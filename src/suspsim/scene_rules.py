@@ -182,16 +182,24 @@ def _resolve_run(run: dict, given: dict, flow: dict, box, fail: Fail) -> dict:
     return out
 
 
-def _check_lattice(dim: int, box, n: float, fail: Fail) -> None:
+def lattice_mismatch(dim: int, box, n: float) -> str | None:
+    """Why a ``dim``-D box of sides ``box`` [h] holds no whole lattice at ``n`` particles per
+    h^dim (more than LATTICE_DENSITY_TOLERANCE off, with box sides that would fit), or None."""
     counts = lattice_counts(box, n)
     actual = math.prod(counts) / math.prod(box)
-    if abs(actual / n - 1) > LATTICE_DENSITY_TOLERANCE:
-        spacing = n ** (-1.0 / dim)
-        fitting = ", ".join(f"{c * spacing:.4g}" for c in counts)
-        fail(("number_density",),
-             f"a {'x'.join(map(str, counts))} lattice gives {actual:.4g} particles per h^{dim} "
-             f"in this box, {100 * (actual / n - 1):+.1f} % off number_density {n:g}; use box "
-             f"sides that are multiples of the spacing {spacing:.4g} h, e.g. [{fitting}]")
+    if abs(actual / n - 1) <= LATTICE_DENSITY_TOLERANCE:
+        return None
+    spacing = n ** (-1.0 / dim)
+    fitting = ", ".join(f"{c * spacing:.4g}" for c in counts)
+    return (f"a {'x'.join(map(str, counts))} lattice gives {actual:.4g} particles per h^{dim} "
+            f"in this box, {100 * (actual / n - 1):+.1f} % off number_density {n:g}; use box "
+            f"sides that are multiples of the spacing {spacing:.4g} h, e.g. [{fitting}]")
+
+
+def _check_lattice(dim: int, box, n: float, fail: Fail) -> None:
+    problem = lattice_mismatch(dim, box, n)
+    if problem:
+        fail(("number_density",), problem)
 
 
 def _has_inclusions(inc: dict) -> bool:

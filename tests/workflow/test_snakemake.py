@@ -79,6 +79,16 @@ def test_invalid_config_is_rejected(tmp_path):
     assert "bingham" in proc.stdout + proc.stderr
 
 
+def test_a_box_without_a_whole_lattice_stops_before_any_job(tmp_path):
+    study = _study(tmp_path, {"a": REPO / "data/carbopol_pg/matrix.csv"})
+    (study / "config/box.yaml").write_text("simulation: {box: 17}\n")
+    proc = _run(study, "-n", "--configfile", "config/box.yaml")
+    assert proc.returncode != 0
+    text = proc.stdout + proc.stderr
+    assert "simulation.box = 17" in text and "multiples of the spacing 0.625 h" in text
+    assert "rule fit_matrix" not in text
+
+
 def test_bad_matrix_file_fails_the_job_with_a_clear_log(tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("Shear rate [1/s],Shear stress [Pa]\n1,2\n2,oops\n", encoding="utf-8")
@@ -228,7 +238,7 @@ def test_sand_study_packs_sand_grains_for_each_phi(tmp_path):
     packing = "results/linear_polymer/packings/phi-0.1_seed-1.nc"
     assert _run(study, packing, *sand).returncode == 0
     with xr.open_dataset(study / packing) as pack:
-        assert pack.attrs["shape"] == "sand" and list(pack.attrs["box"]) == [17.0] * 3
-        # grains reach out to 1.6 volume-equivalent radii: the 17 h box holds them
+        assert pack.attrs["shape"] == "sand" and list(pack.attrs["box"]) == [16.875] * 3
+        # grains reach out to 1.6 volume-equivalent radii: the 16.875 h box holds them
         assert float(pack["support_radius"].max()) <= 1.6 * 2.5 + 1e-9
         assert pack.sizes["body"] >= 1

@@ -9,6 +9,7 @@ from snakemake.utils import validate
 from suspsim.errors import SuspsimError
 from suspsim.io.provenance import code_version
 from suspsim.rheology.readers import read_flow_curve
+from suspsim.scene_rules import lattice_mismatch
 from suspsim.stages.pack import particle_settings
 
 
@@ -37,6 +38,11 @@ CODE = {
 SIMULATION = config["simulation"]
 RESOLUTION = {key: SIMULATION[key] for key in ("box", "number_density", "strain", "transient",
                                                "reynolds", "jitter")}
+# A box that holds no whole lattice would stop every simulate job after the packings are made.
+_LATTICE_PROBLEM = config["material_study"] and lattice_mismatch(
+    3, [SIMULATION["box"]] * 3, SIMULATION["number_density"])
+if _LATTICE_PROBLEM:
+    raise WorkflowError(f"config simulation.box = {SIMULATION['box']:g}: {_LATTICE_PROBLEM}")
 
 
 def _discover_materials():
