@@ -8,6 +8,7 @@ from matplotlib.figure import Figure
 
 from suspsim.errors import InputError
 from suspsim.io.study_variables import STUDY_VARIABLES, SUMMARY_DIMS
+from suspsim.plotting.shapes import plot_shape_comparison, shape_ratio
 from suspsim.plotting.summary import (plot_relative_viscosity_vs_phi, plot_summary,
                                       plot_viscosity, seed_mean)
 from suspsim.rheology.laws import make_law
@@ -196,3 +197,24 @@ def test_relative_viscosity_against_phi_beside_the_estimate_at_each_simulated_ra
     assert curve.get_xdata().tolist() == [0.0, 0.1, 0.2, 0.3, 0.4]
     exact = homogenisation_estimate(FIT, [0.3], [10.0], phi_max=0.57)["relative_viscosity"]
     assert curve.get_ydata()[3] == pytest.approx(float(exact.squeeze()), rel=1e-9)
+
+
+def test_shape_ratio_and_comparison_figure_of_two_studies():
+    spheres = gather_runs([fake_run(r, 1) for r in (0.1, 10.0)]
+                          + [fake_suspension_run(r, 1, phi, 1 + 3 * phi)
+                             for r in (0.1, 10.0) for phi in (0.1, 0.3)], material="m")
+    sand = gather_runs([fake_suspension_run(r, 1, phi, 1 + 4 * phi)
+                        for r in (10.0, 100.0) for phi in (0.1, 0.3)], material="m")
+    ratio = shape_ratio(sand, spheres)
+    assert ratio["shear_rate"].values.tolist() == [10.0]
+    assert ratio["phi"].values.tolist() == [0.1, 0.3]
+    expected = np.array([1.4 / 1.3, 2.2 / 1.9])
+    np.testing.assert_allclose(ratio["ratio"].squeeze("shear_rate").values, expected, rtol=1e-12)
+    # independent errors of 0.01 on each η_r, in quadrature relative to each
+    relative = np.hypot(0.01 / np.array([1.4, 2.2]), 0.01 / np.array([1.3, 1.9]))
+    np.testing.assert_allclose(ratio["ratio_error"].squeeze("shear_rate").values,
+                               expected * relative, rtol=1e-12)
+    fig = plot_shape_comparison({"spheres": spheres, "sand": sand})
+    assert len(fig.axes) == 1 and fig.axes[0].get_title() == "γ̇ = 10 1/s"
+    with pytest.raises(ValueError, match="no shear rate"):
+        plot_shape_comparison({"spheres": spheres.sel(shear_rate=[0.1]), "sand": sand})

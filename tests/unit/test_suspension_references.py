@@ -8,7 +8,7 @@ from suspsim.rheology.suspension import (
     BATCHELOR_BROWNIAN, BATCHELOR_GREEN_STRAINING, batchelor, boyer_friction_coefficient,
     boyer_normal_viscosity, boyer_shear_viscosity, chateau_ovarlez_trung_viscosity,
     cot_herschel_bulkley, einstein, krieger_dougherty, local_shear_rate_factor, maron_pierce,
-    zarraga)
+    published_envelope, zarraga)
 
 
 def assert_printed(value, printed):
@@ -186,3 +186,14 @@ def test_cot_jammed_and_broadcast():
     assert np.isfinite(eta[0]) and np.isinf(eta[1])
     with pytest.raises(ValueError, match="shear rate"):
         chateau_ovarlez_trung_viscosity(hb_matrix(1.0, 1.0, 0.5), -1.0, 0.3, 2.0)
+
+
+@pytest.mark.parametrize("row", [r for r in ROWS_2A if float(r[0]) <= 0.5],
+                         ids=[r[0] for r in ROWS_2A if float(r[0]) <= 0.5])
+def test_published_envelope_is_the_min_max_of_the_experimental_fits(row):
+    """§2a's read-across: the band of the Zarraga, Boyer η_s, MP 0.605, KD 0.57, MP 0.656 columns
+    (5.61–8.78 at φ = 0.4, 17.7–42.8 at 0.5)."""
+    printed = [row[i] for i in (4, 5, 8, 9, 10)]
+    low, high = published_envelope(float(row[0]))
+    assert_printed(float(low), min(printed, key=float))
+    assert_printed(float(high), max(printed, key=float))

@@ -164,6 +164,21 @@ def boyer_friction_coefficient(volume_fraction, mu1=0.32, mu2=0.7, I0=0.005, phi
     return _as_result(np.where(phi > 0.0, mu, np.inf))
 
 
+def published_envelope(volume_fraction) -> tuple[np.ndarray, np.ndarray]:
+    """(lowest, highest) η_r [1] of the published experimental fits at φ: Zarraga et al. (2000),
+    Boyer et al. (2011) η_s, Maron–Pierce with φ_m = 0.605 (Ovarlez et al. 2006) and 0.656
+    (Mueller et al. 2010), Krieger–Dougherty with φ_m = 0.57 (Mahaut et al. 2008).
+
+    The spread is the experimental uncertainty of non-Brownian spheres in a Newtonian fluid
+    (REFERENCE_NUMBERS §2a: 5.61–8.78 at φ = 0.4, 17.7–42.8 at φ = 0.5); meant for φ ≤ 0.5.
+    """
+    fits = np.stack(np.broadcast_arrays(
+        zarraga(volume_fraction), boyer_shear_viscosity(volume_fraction),
+        maron_pierce(volume_fraction, 0.605), maron_pierce(volume_fraction, 0.656),
+        krieger_dougherty(volume_fraction, 0.57)))
+    return _as_result(fits.min(axis=0)), _as_result(fits.max(axis=0))
+
+
 def _cot_inputs(volume_fraction, relative_viscosity) -> tuple[np.ndarray, np.ndarray]:
     phi = _volume_fraction(volume_fraction)
     g = np.asarray(relative_viscosity, dtype=float)
