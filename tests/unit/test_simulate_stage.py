@@ -7,7 +7,7 @@ import math
 import pytest
 import xarray as xr
 
-from suspsim.errors import InputError
+from suspsim.errors import InputError, NumericalError
 from suspsim.io.checkpoint import save_checkpoint
 from suspsim.rheology.laws import make_law
 from suspsim.run import checkpoint_path
@@ -123,3 +123,18 @@ def test_tiny_suspension_run_reads_its_packing_and_records_the_inclusions(tmp_pa
         assert json.loads(run.attrs["inclusions"])["shape"] == run.attrs["inclusion_shape"]
         assert run.attrs["unit_length_scale_m_per_h"] == pytest.approx(1e-4)
         assert json.loads(run.attrs["scene"])["inclusions"]["packing"] == str(packing)
+
+
+def test_study_numerics_reach_the_scene_and_a_blow_up_names_them(tmp_path):
+    scene, _ = simulation_scene(LAW, 3.0, volume_fraction=0.0, seed=1, resolution=TINY,
+                                numerics={"wi_target": 3e-4, "dt_viscous_coefficient": 0.02})
+    assert scene.numerics.wi_target == 3e-4 and scene.numerics.dt_viscous_coefficient == 0.02
+    fit_json = tmp_path / "fit.json"
+    fit_json.write_text(json.dumps(FIT))
+    out = tmp_path / "run.nc"
+    # Ten times the stable viscous step and a slow sound: the health check stops the run.
+    with pytest.raises(NumericalError, match="simulation.numerics in the study config"):
+        simulate_run(fit_json, out, shear_rate=3.0, volume_fraction=0.0, seed=1,
+                     resolution=TINY, numerics={"wi_target": 0.5, "dt_viscous_coefficient": 0.5},
+                     threads=1)
+    assert not out.exists()

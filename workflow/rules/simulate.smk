@@ -18,6 +18,7 @@ rule simulate:
         volume_fraction=run_volume_fraction,
         seed=run_seed,
         resolution=RESOLUTION,
+        numerics=SIMULATION["numerics"],
         particles=run_particles,
         code=CODE["simulate"],
     script:

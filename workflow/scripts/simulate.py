@@ -15,7 +15,8 @@ try:
     simulate_run(snakemake.input.fit, snakemake.output.run,
                  shear_rate=snakemake.params.shear_rate,
                  volume_fraction=snakemake.params.volume_fraction, seed=snakemake.params.seed,
-                 resolution=snakemake.params.resolution, threads=snakemake.threads,
+                 resolution=snakemake.params.resolution, numerics=snakemake.params.numerics,
+                 threads=snakemake.threads,
                  particles=snakemake.params.particles, packing=snakemake.input.packing or None)
 except SuspsimError as err:
     logging.getLogger("suspsim").error("%s", err)

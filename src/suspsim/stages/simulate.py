@@ -35,7 +35,7 @@ from typing import Any, Mapping
 
 import xarray as xr
 
-from ..errors import InputError
+from ..errors import InputError, NumericalError
 from ..io.atomic import atomic_path
 from ..io.checkpoint import load_checkpoint
 from ..io.netcdf import read_run
@@ -59,6 +59,12 @@ REPLACED_RUN_RESULTS = ("phi", "suspension_viscosity", "relative_viscosity",
 #: Largest |φ_packing − φ| accepted between a run's packing and its nominal φ [1]: packings
 #: reach φ to round-off (:mod:`suspsim.bodies.packing`).
 PHI_TOLERANCE = 1e-9
+
+
+#: What a study can change when a run stops numerically (the solver's message names scene keys).
+STUDY_NUMERICS_HINT = ("In a study the time step and sound speed follow simulation.numerics in the "
+                       "study config: lower wi_target for a faster sound speed (smaller density "
+                       "error, smaller step) or dt_viscous_coefficient for a smaller viscous step")
 
 
 @dataclass(frozen=True)
@@ -110,9 +116,12 @@ def read_fit(path: str | os.PathLike) -> dict:
 def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction: float,
                      seed: int, resolution: Resolution, threads: int | None = 1,
                      particles: Particles | None = None,
-                     packing: str | os.PathLike | None = None) -> tuple[Scene, UnitMapping]:
+                     packing: str | os.PathLike | None = None,
+                     numerics: Mapping[str, Any] | None = None) -> tuple[Scene, UnitMapping]:
     """The Couette scene of physical ``shear_rate`` [1/s] for ``law`` (SI) and its mapping.
 
+    ``numerics`` the scene's numerics keys that differ from the solver's defaults (a study's
+    ``simulation.numerics``).
     φ > 0: inclusions of ``particles`` (default :class:`Particles`()) packed with the run's
     ``seed`` and gap :data:`~suspsim.stages.pack.STUDY_MIN_GAP`, read from the file
     ``packing`` when given (it is not opened here); the Reynolds length is their radius [h].
@@ -147,6 +156,7 @@ def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction
                     "start": "linear", "threads": "all" if threads is None else int(threads)},
             "lattice": {"jitter": resolution.jitter},
             "inclusions": inclusions,
+            "numerics": dict(numerics or {}),
             "seed": int(seed)}
     return scene_from_dict(data, source="simulation resolution"), mapping
 
@@ -155,10 +165,11 @@ def simulate_run(fit_json: str | os.PathLike, out_nc: str | os.PathLike, *, shea
                  volume_fraction: float, seed: int, resolution: Mapping[str, Any] | Resolution,
                  threads: int | None = 1,
                  particles: Mapping[str, Any] | Particles | None = None,
-                 packing: str | os.PathLike | None = None) -> xr.Dataset:
+                 packing: str | os.PathLike | None = None,
+                 numerics: Mapping[str, Any] | None = None) -> xr.Dataset:
     """Simulate one (φ, γ̇, seed) of the matrix in ``fit_json`` and write ``out_nc`` atomically.
 
-    ``particles`` and ``packing`` as :func:`simulation_scene` (φ > 0); a packing file must
+    ``particles``, ``packing`` and ``numerics`` as :func:`simulation_scene` (φ > 0); a packing file must
     hold the scene's shape, φ, seed and box. The simulation-unit run goes first to ``out_nc``
     with :data:`SIMULATION_SUFFIX` (and its checkpoint); a checkpoint of the same scene left
     by an interrupted job is resumed, one of another scene is discarded. Returns the written
@@ -175,7 +186,7 @@ def simulate_run(fit_json: str | os.PathLike, out_nc: str | os.PathLike, *, shea
         particles = Particles.from_mapping(particles)
     scene, mapping = simulation_scene(law, shear_rate, volume_fraction=volume_fraction,
                                       seed=seed, resolution=resolution, threads=threads,
-                                      particles=particles, packing=packing)
+                                      particles=particles, packing=packing, numerics=numerics)
     if packing is not None:
         check_packing(packing, scene)
     low, high = fit.get("shear_rate_range", (shear_rate, shear_rate))
@@ -188,7 +199,10 @@ def simulate_run(fit_json: str | os.PathLike, out_nc: str | os.PathLike, *, shea
              "(length %g h); law in simulation units %s", law.name, shear_rate,
              mapping.time_scale, mapping.viscosity_scale, mapping.reynolds_number,
              mapping.reynolds_length, dict(scene.fluid.law.params))
-    run_scene(scene, sim_path, resume=_resumable(sim_path, scene), threads=threads)
+    try:
+        run_scene(scene, sim_path, resume=_resumable(sim_path, scene), threads=threads)
+    except NumericalError as err:
+        raise NumericalError(f"{err}. {STUDY_NUMERICS_HINT}") from None
     run = read_run(sim_path)
     dataset = with_physical_results(run, mapping, scene=scene, volume_fraction=volume_fraction,
                                     seed=seed, resolution=resolution, fit=fit)
