@@ -6,7 +6,7 @@ import pytest
 import xarray as xr
 
 from suspsim.convergence.cases import CASES, Case, DSTPointCase, get_case, snapped_resolution
-from suspsim.convergence.measure import run_configuration
+from suspsim.convergence.measure import run_configuration, run_or_failure
 from suspsim.convergence.study import (case_dataset, cheapest_meeting, configuration_id,
                                        configurations, cost_table, pareto_front)
 from suspsim.errors import InputError
@@ -35,6 +35,44 @@ def test_every_case_builds_the_same_physics_at_every_resolution(name):
     assert [s.flow.shear_rate for s in scenes] == pytest.approx([scenes[0].flow.shear_rate] * 3)
     assert [s.flow.body_force for s in scenes] == pytest.approx([scenes[0].flow.body_force] * 3,
                                                                 rel=1e-9)
+
+
+def test_channel_case_at_another_reynolds_number():
+    """Re = u_max W/ν at W = 5 h: 0.1 for the training channel, 1 for the held-out one; the
+    centre-line velocity of the split-force channel is g W²/(8ν) (SPEC 6.2)."""
+    from suspsim.sph.timestep import velocity_scale
+
+    for name, reynolds in [("poiseuille_newtonian_3d", 0.1), ("poiseuille_newtonian_re1_3d", 1.0)]:
+        case = get_case(name)
+        scene = case.build(case.settings({"width": 5.0}))
+        nu = float(scene.fluid.law.viscosity(0.0)) / scene.density
+        assert velocity_scale(scene) * 5.0 / nu == pytest.approx(reynolds, rel=1e-6)
+
+
+def test_failed_run_is_kept_as_a_failure():
+    """A blow-up (NumericalError) or NaN positions failing the profile binning (ValueError)
+    become a configuration with a failure message, so a sweep keeps going."""
+    from suspsim.errors import NumericalError
+
+    base = get_case("poiseuille_newtonian_2d")
+
+    class Failing:
+        name, axes, settings = base.name, base.axes, base.settings
+
+        def __init__(self, error):
+            self.error = error
+
+        def warm_up(self, settings, threads):
+            pass
+
+        def execute(self, settings, threads):
+            raise self.error
+
+    for error in (NumericalError("density out of bounds"), ValueError("negative bin")):
+        record = run_or_failure(Failing(error), {"width": 2.5})
+        assert record["width"] == 2.5 and type(error).__name__ in record["failure"]
+    with pytest.raises(TypeError):
+        run_or_failure(Failing(TypeError("a bug is not a blow-up")), {})
 
 
 def test_case_rejects_unknown_setting_and_name():

@@ -24,7 +24,8 @@ transient (``validation.flows``).
 
 Poiseuille (SPEC §6.2, split force): width W = L_y/2 [h], lateral sides at least 3.75 h (3D) or 8 h
 (2D), rounded up to whole rows. Newtonian: ν = 1.25 h²/τ, u_max = g W²/(8ν) kept at its W = 5 h
-value (g = 0.01 h τ⁻² there), run 3 t_ν, t_ν = W²/ν, the last t_ν averaged. Bingham (Papanastasiou,
+value (g = 0.01 h τ⁻² there, Re = u_max W/ν = 0.1; a case at another Re scales g), run 3 t_ν,
+t_ν = W²/ν, the last t_ν averaged. Bingham (Papanastasiou,
 μ_0/μ_pl = 99, M = 100, ν_pl = 20/4.096 h²/τ): the body force of the Bingham number
 (``reference.poiseuille``), started from the Newtonian profile of equal flow rate, run 0.8 t_pl and
 the last 0.2 t_pl averaged, t_pl = W²/ν_pl. Error: L2/peak of the averaged profile.
@@ -54,6 +55,8 @@ COUETTE_RATE = 0.01
 PAPANASTASIOU_RATIO, PAPANASTASIOU_M = 99.0, 100.0
 #: Kinematic viscosity of the Newtonian channel [h² τ⁻¹] and its force at W = 5 h [h τ⁻²].
 CHANNEL_NU, CHANNEL_FORCE, CHANNEL_WIDTH = 1.25, 0.01, 5.0
+#: Reynolds number u_max W/ν of that channel at W = 5 h [1] (g W²/(8ν) × W/ν = 0.1).
+CHANNEL_REYNOLDS = 0.1
 #: Kinematic plastic viscosity of the Bingham channel [h² τ⁻¹] (the validation's μ_pl = 20 at
 #: n = 4.096).
 BINGHAM_NU = 20.0 / 4.096
@@ -240,12 +243,14 @@ def _channel_box(settings, dim: int) -> tuple[list[float], float]:
     return box, q ** dim
 
 
-def newtonian_poiseuille(dim: int = 3) -> Case:
-    """Newtonian split-force Poiseuille, ν = 1.25, u_max of g = 0.01 at W = 5 h."""
+def newtonian_poiseuille(dim: int = 3, reynolds: float = CHANNEL_REYNOLDS) -> Case:
+    """Newtonian split-force Poiseuille, ν = 1.25, u_max kept at its W = 5 h value, the channel
+    Reynolds number ``reynolds`` = u_max W/ν at W = 5 h (0.1: g = 0.01 there)."""
     def scene(settings):
         box, density = _channel_box(settings, dim)
         width = float(settings["width"])
-        g = CHANNEL_FORCE * (CHANNEL_WIDTH / width) ** 2
+        g = (CHANNEL_FORCE * (reynolds / CHANNEL_REYNOLDS)
+             * (CHANNEL_WIDTH / width) ** 2)
         t_visc = width ** 2 / CHANNEL_NU
         return {"dimension": dim, "box": box, "number_density": density,
                 "kernel": settings["kernel"],
@@ -257,7 +262,9 @@ def newtonian_poiseuille(dim: int = 3) -> Case:
     def measure(sim, settings):
         t_visc = float(settings["width"]) ** 2 / CHANNEL_NU
         return poiseuille_profile_error(sim, run_time=3.0 * t_visc, averaging=t_visc)
-    return Case(f"poiseuille_newtonian_{dim}d", f"Newtonian Poiseuille ({dim}D)",
+    tag = "" if reynolds == CHANNEL_REYNOLDS else f"_re{reynolds:g}"
+    return Case(f"poiseuille_newtonian{tag}_{dim}d",
+                f"Newtonian Poiseuille ({dim}D), Re = {reynolds:g} at W = 5 h",
                 "parabolic split-force profile (SPEC 6.2)", _channel_axes(dim), scene, measure)
 
 
@@ -358,6 +365,8 @@ CASES: dict[str, AnyCase] = {case.name: case for case in (
     papanastasiou_couette(99.0, 3), newtonian_poiseuille(3), newtonian_poiseuille(2),
     bingham_poiseuille(1.0, 3), bingham_poiseuille(3.0, 3), bingham_poiseuille(5.0, 3),
     bingham_poiseuille(10.0, 3),
+    # the blind held-out set of docs/figures/error_model/run_holdout_blind.sh: never fitted on
+    papanastasiou_couette(9.9, 2), bingham_poiseuille(7.0, 3), newtonian_poiseuille(3, 1.0),
     dst_flow_curve_point(0.54, 2.5),
     dst_flow_curve_point(0.50, 1.0))}
 

@@ -25,9 +25,9 @@ import xarray as xr
 
 from suspsim.convergence.cases import Case, get_case
 from suspsim.convergence.error_model import ErrorModel, evaluate, load_model, pick
-from suspsim.convergence.measure import run_configuration
+from suspsim.convergence.measure import run_or_failure
 from suspsim.convergence.study import case_dataset
-from suspsim.errors import InputError, NumericalError
+from suspsim.errors import InputError
 
 log = logging.getLogger(__name__)
 #: Largest allowed ratio of the picked run's cost to the cheapest one meeting the tolerance.
@@ -63,13 +63,7 @@ def check(case_name: str, tolerance: float, *, max_runs: int = 6,
     records = []
     for settings in comparison_settings(case, tolerance, model, max_runs):
         overrides = {k: v for k, v in settings.items() if v != case.settings()[k]}
-        try:
-            records.append(run_configuration(case, overrides))
-        except (NumericalError, ValueError) as err:
-            # ValueError: a run whose positions went NaN between health checks fails in the
-            # profile binning; it is a failed configuration of the sweep like a blow-up
-            records.append({**settings, "failure": f"{type(err).__name__}: {err}",
-                            "threads": 1})
+        records.append(run_or_failure(case, overrides))
     ds = case_dataset(case, records)
     bound = ds["error_bound"].values
     cpu = ds["cpu_time"].values

@@ -14,6 +14,7 @@ import time
 from typing import Any, Mapping
 
 from suspsim.convergence.cases import AnyCase
+from suspsim.errors import NumericalError
 
 log = logging.getLogger(__name__)
 
@@ -46,3 +47,18 @@ def run_configuration(case: AnyCase, overrides: Mapping[str, Any] | None = None,
     log.info("%s %s: error %.3g in %.1f s (%d particles, %d steps)", case.name,
              dict(overrides or {}), record["error"], wall, run.n_particles, run.n_steps)
     return record
+
+
+def run_or_failure(case: AnyCase, overrides: Mapping[str, Any] | None = None, *,
+                   threads: int = 1) -> dict[str, Any]:
+    """:func:`run_configuration`, or for a run that blew up the settings with its ``failure``
+    message (the sweep keeps it as a configuration with NaN measurements). A ValueError counts
+    as a blow-up: positions that went NaN between two health checks fail in the profile
+    binning."""
+    try:
+        return run_configuration(case, overrides, threads=threads)
+    except (NumericalError, ValueError) as err:
+        log.warning("%s %s blew up: %s: %s", case.name, dict(overrides or {}),
+                    type(err).__name__, err)
+        return {**case.settings(overrides), "failure": f"{type(err).__name__}: {err}",
+                "threads": threads}

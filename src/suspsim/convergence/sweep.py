@@ -1,5 +1,5 @@
 """Grid sweeps of a validation case for the error model (:mod:`.error_model`): every combination
-of the listed settings, measured with :func:`~.measure.run_configuration` and stored as one
+of the listed settings, measured with :func:`~.measure.run_or_failure` and stored as one
 netCDF Dataset (:func:`~.study.case_dataset`, cost = CPU time of one thread [s]); a
 configuration that blows up is kept with NaN measurements and its message in ``failure``.
 
@@ -18,13 +18,10 @@ from typing import Any, Mapping, Sequence
 import xarray as xr
 
 from suspsim.convergence.cases import get_case
-from suspsim.convergence.measure import run_configuration
+from suspsim.convergence.measure import run_or_failure
 from suspsim.convergence.study import case_dataset, configurations
-from suspsim.errors import NumericalError
 from suspsim.io.atomic import atomic_path
 from suspsim.io.provenance import provenance
-
-log = logging.getLogger(__name__)
 
 
 def grid_sweep(case_name: str, values: Mapping[str, Sequence[Any]], out: str | os.PathLike, *,
@@ -33,11 +30,7 @@ def grid_sweep(case_name: str, values: Mapping[str, Sequence[Any]], out: str | o
     case = get_case(case_name)
     records = []
     for overrides in configurations(case, values, sweep="grid"):
-        try:
-            records.append(run_configuration(case, overrides, threads=threads))
-        except NumericalError as err:
-            log.warning("%s %s blew up: %s", case_name, overrides, err)
-            records.append({**case.settings(overrides), "failure": str(err), "threads": threads})
+        records.append(run_or_failure(case, overrides, threads=threads))
     ds = case_dataset(case, records)
     ds.attrs.update(sweep="grid", values=json.dumps(dict(values)), command=command,
                     **provenance())
