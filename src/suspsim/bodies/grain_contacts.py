@@ -154,9 +154,10 @@ def _best_sample(points_a, rot_a, ox, oy, oz, table_b, to_packing_b, rot_b, cent
     A's centre of mass is at the origin, B's at (ox, oy, oz) [h]; ``rot_*`` principal → box;
     B's centroid is at o + rot_b centroid_b. Points farther than ``reach_b`` from the centroid
     are skipped; (−1, inf) if none is within."""
-    cx = ox + rot_b[0, 0] * centroid_b[0] + rot_b[0, 1] * centroid_b[1] + rot_b[0, 2] * centroid_b[2]
-    cy = oy + rot_b[1, 0] * centroid_b[0] + rot_b[1, 1] * centroid_b[1] + rot_b[1, 2] * centroid_b[2]
-    cz = oz + rot_b[2, 0] * centroid_b[0] + rot_b[2, 1] * centroid_b[1] + rot_b[2, 2] * centroid_b[2]
+    gx, gy, gz = centroid_b[0], centroid_b[1], centroid_b[2]
+    cx = ox + rot_b[0, 0] * gx + rot_b[0, 1] * gy + rot_b[0, 2] * gz
+    cy = oy + rot_b[1, 0] * gx + rot_b[1, 1] * gy + rot_b[1, 2] * gz
+    cz = oz + rot_b[2, 0] * gx + rot_b[2, 1] * gy + rot_b[2, 2] * gz
     # box → packing frame of B: m = Pᵀ Qᵀ
     m = np.empty((3, 3))
     for i in range(3):
