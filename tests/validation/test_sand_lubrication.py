@@ -7,7 +7,7 @@ gap ≥ 0.05 h): with lubrication between volume-equivalent spheres it reported 
 grains (bodies.grain_lubrication_pass) the gaps stay positive, no body outruns the walls and
 the fluid's density error stays under the run's limit.
 
-Slow (packing and set-up ≈ 35 s, then ≈ 0.03 s a step: 43 s reduced, ≈ 50 s full);
+Slow (packing and set-up ≈ 35 s, then ≈ 0.03 s a step: 43 s reduced, 37 s full on a quiet core);
 ``SUSPSIM_REDUCED=1`` runs 60 steps instead of 300.
 """
 import os

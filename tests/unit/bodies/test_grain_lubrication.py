@@ -227,3 +227,44 @@ def test_squeeze_between_grains_follows_the_curvatures_at_the_closest_points(see
     # point ≤ 0.05 h from the closest point
     assert stats[SMALLEST_GAP] == pytest.approx(gap, abs=1e-3)
     assert force == pytest.approx(expected, rel=0.05)
+
+
+def _kinetic_energy(velocities, omegas, mass, moments, rotations):
+    """Σ ½ M V² + ½ Ωᵀ I Ω, I = Q diag(I₁, I₂, I₃) Qᵀ (box frame)."""
+    body = np.einsum("bji,bj->bi", rotations, omegas)
+    return 0.5 * float((mass * (velocities ** 2).sum(1)).sum() + (moments * body ** 2).sum())
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_grain_impulses_conserve_momentum_and_dissipate(seed):
+    """Lubrication alone (no repulsion): total momentum and angular momentum about the origin are
+    unchanged (J₂ = −J₁, torques L + ℓ × J about each centre of mass), and the kinetic energy
+    with the full inertia tensors does not grow; dt large enough to be stiff."""
+    rng = np.random.default_rng(200 + seed)
+    grains = [_grain(31 + 2 * seed + k) for k in range(2)]
+    coefficients = [g[0] for g in grains]
+    support = [g[1] for g in grains]
+    rotations = rotation_matrices(random_quaternions(2, rng))
+    direction = rng.normal(size=3)
+    direction /= np.linalg.norm(direction)
+    centres = _place(coefficients, support, rotations, direction, 0.1, points=6000)
+    surfaces = _surfaces(coefficients, [2.5, 2.5], support)
+    mass = np.full(2, 270.0)
+    moments = np.array([[330.0, 560.0, 640.0], [300.0, 520.0, 700.0]])
+    velocities = rng.normal(scale=0.1, size=(2, 3))
+    omegas = rng.normal(scale=0.05, size=(2, 3))
+    law = make_law("newtonian", {"mu": 1.0})
+    new_v, new_w, _, stats = _run_pass(surfaces, centres, rotations, velocities, omegas, mass,
+                                       moments, 0.0, law, dt=5.0)
+    assert stats[PAIRS] == 1
+
+    def momenta(v, w):
+        body = np.einsum("bji,bj->bi", rotations, w)
+        spin = np.einsum("bij,bj->bi", rotations, moments * body)
+        return (mass[:, None] * v).sum(0), (np.cross(centres, mass[:, None] * v) + spin).sum(0)
+
+    before, after = momenta(velocities, omegas), momenta(new_v, new_w)
+    np.testing.assert_allclose(after[0], before[0], atol=1e-12 * 270.0)
+    np.testing.assert_allclose(after[1], before[1], atol=1e-10 * 270.0 * 20.0)
+    energy = _kinetic_energy(velocities, omegas, mass, moments, rotations)
+    assert 0.0 < energy - _kinetic_energy(new_v, new_w, mass, moments, rotations) < energy
