@@ -47,7 +47,7 @@ from .lubrication import (_cross, _pair_geometry, normal_potential, normal_resis
                           pair_mode_resistances, repulsion_force, repulsion_slope,
                           sphere_squeeze_law)
 
-__all__ = ["implicit_normal_gap", "lubrication_pair_impulse"]
+__all__ = ["implicit_normal_gap", "lubrication_pair_impulse", "lubrication_pair_impulse_law"]
 
 #: Newton iterations allowed in the normal-mode solve (bisection fallback keeps the bracket).
 MAX_ITERATIONS = 200
@@ -116,6 +116,28 @@ def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1
     the end of the step (s + δt x, normal mode, module docstring); ≤ 0 flags an overlap, which the
     scheme excludes unless the capped forces below ``min_gap`` are overpowered.
     """
+    c1, c2, c3, ell = sphere_squeeze_law(a1, a2)
+    return _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt,
+                         mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, out)
+
+
+@njit(**JIT_OPTIONS)
+def lubrication_pair_impulse_law(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1,
+                                 I2, dt, mu, c1, c2, c3, ell, cutoff_gap, min_gap,
+                                 repulsion_strength, out):
+    """:func:`lubrication_pair_impulse` with the normal law (c1, c2, c3, ℓ) of
+    :func:`~suspsim.bodies.lubrication.normal_resistance` given: e.g. c1 from the curvatures
+    of two non-spherical surfaces (SPEC §3.4,
+    :func:`~suspsim.bodies.lubrication.curved_squeeze_coefficient`) and c2, c3, ℓ of the
+    spheres a1, a2 that osculate them (:mod:`~suspsim.bodies.grain_lubrication_pass`). The
+    tangential and twist modes are those of the spheres a1, a2."""
+    return _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt,
+                         mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, out)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt, mu, c1, c2,
+                  c3, ell, cutoff_gap, min_gap, repulsion_strength, out):
     dx, dy, dz, s, kap = _pair_geometry(a1, a2, r12)
     out[:, :] = 0.0
     v1x, v1y, v1z = U1[0] + dU1[0], U1[1] + dU1[1], U1[2] + dU1[2]
@@ -126,7 +148,6 @@ def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1
     un = ux * dx + uy * dy + uz * dz
     inv_m = 1.0 / m1 + 1.0 / m2
     # normal mode: exact impulse, implicit in the end-of-step gap
-    c1, c2, c3, ell = sphere_squeeze_law(a1, a2)
     s_new, j_lub, j_rep = implicit_normal_gap(s, -un, inv_m, dt, mu, c1, c2, c3, ell,
                                               cutoff_gap, min_gap, repulsion_strength)
     jn = j_lub + j_rep

@@ -9,9 +9,10 @@ close neighbours. Pairs are found among all B(B − 1)/2 with the Lees–Edwards
 the centres (SPEC §2.7): the image of body 2 one box height up moves γ̇ L_y faster in x.
 
 The viscosity of each gap is the matrix law at the gap shear rate (seed 000's heuristic,
-:func:`~suspsim.bodies.lubrication.gap_viscosity`). Bodies are treated as spheres of their
-volume-equivalent radius with the scalar moment of inertia tr(I)/3 — exact for spheres, an
-approximation for sand grains [choice].
+:func:`~suspsim.bodies.lubrication.gap_viscosity`). The bodies are spheres, with the scalar
+moment of inertia tr(I)/3; sand grains have their own pass at their true closest points
+(:mod:`~suspsim.bodies.grain_lubrication_pass`), which shares this pass's statistics and virial
+layout.
 
 Stress (SPEC §3.5): the impulse J₁ on body 1 over δt is the step-mean force F₁₂ = J₁/δt, and
 the pass adds Σ_pairs F₁₂ ⊗ r₁₂ (r₁₂ = R₁ − R₂, minimum image) to the virial in the layout

@@ -42,7 +42,8 @@ class InclusionSetup:
 
     ``body_of`` (N,) body of each particle (−1 fluid); ``offsets`` (N, 3) principal-frame
     offsets of body particles [h] (0 for fluid); ``reference_count`` N_lattice (module
-    docstring).
+    docstring); ``centre_shift`` (B, 3) and ``body_to_principal`` (B, 3, 3) the lattice
+    centres of mass [h] and frame rotations of :class:`~suspsim.bodies.construction.BodyParticles`.
     """
 
     positions: np.ndarray
@@ -52,6 +53,8 @@ class InclusionSetup:
     bodies: RigidBodies
     packing: Packing
     reference_count: int
+    centre_shift: np.ndarray
+    body_to_principal: np.ndarray
 
 
 def initial_body_motion(scene: Scene, centres: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -107,4 +110,5 @@ def build_inclusions(scene: Scene, packing: Packing | None = None) -> InclusionS
     angular = bodies.angular_velocities()
     velocities[n_fluid:] = (bodies.velocities[built.body_index]
                             + np.cross(angular[built.body_index], shells))
-    return InclusionSetup(positions, velocities, body_of, offsets, bodies, packing, len(lattice))
+    return InclusionSetup(positions, velocities, body_of, offsets, bodies, packing, len(lattice),
+                          built.centre_shift, built.body_to_principal)

@@ -31,6 +31,8 @@ import numba
 import numpy as np
 
 from suspsim.bodies.coupling import body_force_torque, place_body_particles
+from suspsim.bodies.grain_contacts import grain_surfaces
+from suspsim.bodies.grain_lubrication_pass import grain_lubrication_pass
 from suspsim.bodies.lubrication_pass import OVERLAPS, SMALLEST_GAP, lubrication_pass
 from suspsim.rheology.laws import make_law
 from suspsim.scene import Scene
@@ -92,6 +94,7 @@ class Simulation:
         self._mass = scene.mass
         self.bodies = None
         self.packing = None
+        self._grains = None
         reference_count = None
         if _state is not None:
             positions, velocities = _state["positions"], _state["velocities"]
@@ -102,6 +105,9 @@ class Simulation:
                 self._body_volume = float(_state["body_volume"])
                 self._body_radii = np.asarray(_state["body_radii"], dtype=float)
                 reference_count = int(_state["reference_count"])
+                if "grains" in _state:
+                    self._grains = {key: np.asarray(value, dtype=float)
+                                    for key, value in _state["grains"].items()}
         elif scene.inclusions.present:
             from suspsim.sph.inclusions import build_inclusions
 
@@ -111,6 +117,11 @@ class Simulation:
             self._body_volume = float(setup.packing.volumes.sum())
             self._body_radii = np.asarray(setup.packing.radii, dtype=float)
             reference_count = setup.reference_count
+            if setup.packing.coefficients is not None:
+                self._grains = {"coefficients": setup.packing.coefficients,
+                                "support_radii": setup.packing.support_radii,
+                                "centre_shift": setup.centre_shift,
+                                "body_to_principal": setup.body_to_principal}
         else:
             positions = lattice_positions(scene)
             velocities = initial_velocities(scene, positions)
@@ -322,25 +333,42 @@ class Simulation:
         return forces, torques
 
     def _lubrication_setup(self):
-        """(s_c, s_min, repulsion C, scalar inertia) or None (``inclusions.lubrication``):
-        C = k μ(γ̇) γ̇ ā² s_min⁸ with ā the bodies' mean radius."""
+        """(s_c, s_min, repulsion C, scalar inertia, grain surfaces or None) or None
+        (``inclusions.lubrication``): C = k μ(γ̇) γ̇ ā² s_min⁸ with ā the bodies' mean radius;
+        grains get their surface samples (``bodies.grain_contacts``)."""
         spec = self.scene.inclusions.lubrication
         if self.bodies is None or not spec.enabled:
             return None
         rate = self._rate
         strength = (spec.repulsion * float(self.scene.fluid.law.viscosity(rate)) * rate
                     * float(np.mean(self._body_radii)) ** 2 * spec.min_gap ** 8)
-        return spec.cutoff_gap, spec.min_gap, strength, self.bodies.moments.mean(axis=1)
+        surfaces = None
+        if self._grains is not None:
+            g = self._grains
+            surfaces = grain_surfaces(g["coefficients"], self._body_radii, g["support_radii"],
+                                      g["centre_shift"], g["body_to_principal"])
+        return spec.cutoff_gap, spec.min_gap, strength, self.bodies.moments.mean(axis=1), surfaces
 
     def _lubricate(self, time: float) -> None:
-        """Implicit lubrication impulses on the kicked bodies (``bodies.lubrication_pass``)."""
+        """Implicit lubrication impulses on the kicked bodies (``bodies.lubrication_pass``;
+        grains at their closest points, ``bodies.grain_lubrication_pass``)."""
         bodies, law = self.bodies, self.scene.fluid.law
-        cutoff, min_gap, strength, inertia = self._lubrication
+        cutoff, min_gap, strength, inertia, surfaces = self._lubrication
         omegas = bodies.angular_velocities()
-        lubrication_pass(bodies.centres, self._body_radii, bodies.velocities, omegas,
-                         bodies.mass, inertia, self._box, self._offset(time), self._rate,
-                         self.dt, law.code, law.packed, cutoff, min_gap, strength,
-                         self._lubrication_virial, self._lubrication_stats)
+        if surfaces is None:
+            lubrication_pass(bodies.centres, self._body_radii, bodies.velocities, omegas,
+                             bodies.mass, inertia, self._box, self._offset(time), self._rate,
+                             self.dt, law.code, law.packed, cutoff, min_gap, strength,
+                             self._lubrication_virial, self._lubrication_stats)
+        else:
+            sf = surfaces
+            grain_lubrication_pass(bodies.centres, bodies.rotations(), bodies.velocities, omegas,
+                                   bodies.mass, bodies.moments, self._box, self._offset(time),
+                                   self._rate, self.dt, law.code, law.packed, cutoff, min_gap,
+                                   strength, sf.points, sf.normals, sf.first_directions,
+                                   sf.osculating, sf.principal_curvatures, sf.tables,
+                                   sf.to_packing, sf.centroids, sf.reach,
+                                   self._lubrication_virial, self._lubrication_stats)
         bodies.set_angular_velocities(omegas)
 
     def _advance_python(self, n_steps: int) -> None:
@@ -564,6 +592,8 @@ class Simulation:
                        lubrication_virial=self._lubrication_virial.copy(),
                        reference_count=round(self._rho_eq * self.scene.volume / self._mass),
                        body_virial=self._body_virial.copy())
+            if self._grains is not None:
+                out["grains"] = {key: np.array(value) for key, value in self._grains.items()}
         return out
 
     @classmethod
