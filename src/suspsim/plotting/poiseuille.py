@@ -46,7 +46,8 @@ def plot_poiseuille(data: xr.Dataset, ax=None) -> Figure:
     ax.set_xlim(-0.5, 0.5)
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="small", loc="lower center")
+    # Between the Bn = 1 plateau and the flatter plugs, clear of every curve.
+    ax.legend(fontsize="small", loc="center", bbox_to_anchor=(0.5, 0.37))
     dim = int(data.attrs["dimension"])
     ax.set_title(f"Split-force Poiseuille, Papanastasiou: SPH (markers, {dim}D, "
                  f"n = {data.attrs['number_density']:g}/h{'²' if dim == 2 else '³'}, "
