@@ -18,6 +18,7 @@ include: "workflow/rules/simulate.smk"
 include: "workflow/rules/gather.smk"
 include: "workflow/rules/speed_error.smk"
 include: "workflow/rules/dst.smk"
+include: "workflow/rules/flows.smk"
 
 
 rule all:
