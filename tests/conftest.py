@@ -8,3 +8,8 @@ import os
 # Set before the first import of numba.
 if os.environ.get("PYTEST_XDIST_WORKER"):
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+# Shared fixtures are session-scoped, not module-scoped: with --dist loadgroup a worker runs the
+# tests of several modules interleaved, and a module fixture is torn down whenever the worker
+# leaves its module, so an expensive one was rebuilt (the DST split run, 249 s, and the report
+# study, 72-77 s, twice each in the reduced CI suite). A fixture stays visible to its own module.

@@ -133,7 +133,7 @@ def mangled_bytes(draw, fixtures):
     return path.suffix, data
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def fuzz_dir(tmp_path_factory):
     return tmp_path_factory.mktemp("fuzz")
 

@@ -261,7 +261,7 @@ SPLIT_RUN = (dict(lattice=(N_X, 10), equilibration_strain=15.0, averaging_strain
                   samples=40, n_blocks=8))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def split_run():
     """One zero-non-locality run (α = 0, φ = 0.54, σ_in = 2σ*) shared by the two tests below."""
     start = time.perf_counter()

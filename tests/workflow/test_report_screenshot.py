@@ -79,7 +79,7 @@ def _script_json(html, name):
     return json.loads(match[1])
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def report(tmp_path_factory):
     """The smoke study run in a copy of the workflow, then its report: (study folder, report)."""
     study = _study(tmp_path_factory.mktemp("report") / "study",

@@ -44,19 +44,19 @@ def lattice(reach, spacing, dimension=3):
     return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def sphere():
     return build_body_particles(packing([5.0, 5.0, 5.0], 2.5), N3)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def grain_packing():
     coefficients = random_grain(np.random.default_rng(7)) * 3.0
     q = random_quaternions(1, np.random.default_rng(1))
     return packing([5.0, 5.0, 5.0], 3.0, coefficients[None], orientations=q)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def grain(grain_packing):
     return build_body_particles(grain_packing, N3)
 

@@ -9,7 +9,7 @@ from suspsim.bodies import shapes, sizes
 from suspsim.bodies.grains import elongation_and_flatness, random_grain
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def grains():
     rng = np.random.default_rng(21)
     return [random_grain(rng) for _ in range(6)]

@@ -56,7 +56,7 @@ def assert_grains_do_not_overlap(result, points=3000):
     return smallest
 
 
-@pytest.fixture(scope="module", autouse=True)
+@pytest.fixture(scope="session", autouse=True)
 def compiled():
     """Compile (or load from cache) the kernels before anything is timed."""
     pack_spheres([10, 10, 10], 0.2, 1.0, seed=0)

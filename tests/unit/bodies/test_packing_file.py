@@ -9,12 +9,12 @@ from suspsim.io.packing_file import read_packing, write_packing
 from suspsim.io.variables import PACKING_ATTRIBUTES, PACKING_VARIABLES
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def spheres():
     return pack_spheres([10, 12, 14], 0.4, 1.0, polydispersity=0.2, seed=3)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def sand():
     return pack_sand([7, 7, 7], 0.3, 1.0, seed=2, degree=6)
 

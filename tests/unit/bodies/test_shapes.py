@@ -19,14 +19,14 @@ def directions_with_poles(count=300, seed=0):
     return np.vstack([u, np.eye(3), -np.eye(3)])
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def ellipsoid():
     """Degree-30 projection of the ellipsoid with semi-axes AXES (truncation error ~1e-8)."""
     grid = sh.gauss_grid(30, 100)
     return sh.project(1.0 / np.sqrt(((grid.directions / AXES) ** 2).sum(-1)), grid)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def grain():
     return random_grain(np.random.default_rng(11), roughness=0.05)
 

@@ -211,7 +211,7 @@ def _band_runs():
     return runs
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def gathered():
     points = study_points(SETTINGS)
     return gather_flow_curves([fake_run(SETTINGS, p) for p in points], SETTINGS,
@@ -267,7 +267,7 @@ def test_gather_rejects_runs_that_are_not_the_study_points():
         gather_flow_curves(runs, SETTINGS)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def flow_curves_file(tmp_path_factory):
     folder = tmp_path_factory.mktemp("dst")
     files = []

@@ -19,7 +19,7 @@ def suspension_scene(phi=0.1, side=7.5, radius=1.5, **numerics):
         "numerics": numerics})
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def suspension():
     return Simulation(suspension_scene(), threads=1)
 

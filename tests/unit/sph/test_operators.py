@@ -40,7 +40,7 @@ def disordered(number_density):
                               sound_speed=2.0)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def configurations():
     return {(n, kind): (relaxed_simulation(3, 5.0, n) if kind == "lattice" else disordered(n))
             for n in RESOLUTIONS for kind in ("lattice", "disordered")}

@@ -31,7 +31,7 @@ def smoothed(sim):
     return gdot, mu
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def disordered():
     return relaxed_simulation(3, 8.125, 4.096, jitter=0.3, relax_steps=60, sound_speed=2.0,
                               law="power_law", params={"K": 1.0, "n": 0.5})
