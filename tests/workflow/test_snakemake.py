@@ -244,3 +244,10 @@ def test_sand_study_packs_sand_grains_for_each_phi(tmp_path):
         support = float(pack["support_radius"].max())
         assert 2.5 < support and 4 * support + 0.1 <= 16.875
         assert pack.sizes["body"] >= 1
+
+
+def test_a_study_with_its_own_results_folder_logs_apart(tmp_path):
+    study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
+    dry = _run(study, "-n", "--configfile", "config/studies/sand.yaml")
+    logs = re.findall(r"^\s+log: (.*)$", dry.stdout + dry.stderr, re.MULTILINE)
+    assert logs and all(path.startswith("logs/sand/") for path in logs)

@@ -17,6 +17,9 @@ validate(config, "../schemas/config.schema.yaml")
 
 DATA = Path(config["data_dir"])
 RESULTS = Path(config["results_dir"])
+# A study with its own results folder (results/<name>) logs to logs/<name>/: two studies of one
+# material never overwrite each other's logs and benchmarks.
+LOGS = "logs" if RESULTS == Path("results") else f"logs/{RESULTS.name}"
 
 
 wildcard_constraints:

@@ -80,9 +80,9 @@ rule simulate_dst_point:
     output:
         run=f"{DST_DIR}/runs/phi-{{phi}}_nonlocality-{{nonlocality}}_stress-{{index}}.nc",
     log:
-        "logs/simulate_dst_point/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.log",
+        LOGS + "/simulate_dst_point/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.log",
     benchmark:
-        "logs/benchmarks/simulate_dst_point/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.tsv"
+        LOGS + "/benchmarks/simulate_dst_point/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.tsv"
     wildcard_constraints:
         nonlocality=r"[A-Za-z0-9-]+",
         index=r"[0-9]+",
@@ -99,9 +99,9 @@ use rule simulate_dst_point as simulate_dst_band with:
     output:
         run=f"{DST_DIR}/bands/phi-{{phi}}_nonlocality-{{nonlocality}}_stress-{{index}}.nc",
     log:
-        "logs/simulate_dst_band/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.log",
+        LOGS + "/simulate_dst_band/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.log",
     benchmark:
-        "logs/benchmarks/simulate_dst_band/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.tsv"
+        LOGS + "/benchmarks/simulate_dst_band/phi-{phi}_nonlocality-{nonlocality}_stress-{index}.tsv"
     params:
         scene=dst_band_scene,
         code=CODE_DST["simulate"],
@@ -114,9 +114,9 @@ rule gather_dst:
     output:
         flow_curves=f"{DST_DIR}/flow_curves.nc",
     log:
-        "logs/gather_dst/gather_dst.log",
+        LOGS + "/gather_dst/gather_dst.log",
     benchmark:
-        "logs/benchmarks/gather_dst/gather_dst.tsv"
+        LOGS + "/benchmarks/gather_dst/gather_dst.tsv"
     params:
         settings=DST,
         code=CODE_DST["gather"],
@@ -149,9 +149,9 @@ rule plot_dst:
             category="Discontinuous shear thickening",
         ),
     log:
-        "logs/plot_dst/plot_dst.log",
+        LOGS + "/plot_dst/plot_dst.log",
     benchmark:
-        "logs/benchmarks/plot_dst/plot_dst.tsv"
+        LOGS + "/benchmarks/plot_dst/plot_dst.tsv"
     params:
         figure=DST["figure"],
         code=CODE_DST["figures"],
@@ -163,9 +163,9 @@ rule simulate_dst_channel:
     output:
         run=f"{DST_DIR}/channel/{{set}}_force-{{index}}.nc",
     log:
-        "logs/simulate_dst_channel/{set}_force-{index}.log",
+        LOGS + "/simulate_dst_channel/{set}_force-{index}.log",
     benchmark:
-        "logs/benchmarks/simulate_dst_channel/{set}_force-{index}.tsv"
+        LOGS + "/benchmarks/simulate_dst_channel/{set}_force-{index}.tsv"
     wildcard_constraints:
         set=r"[A-Za-z0-9-]+",
         index=r"[0-9]+",
@@ -183,9 +183,9 @@ rule gather_dst_channel:
     output:
         channel=f"{DST_DIR}/channel.nc",
     log:
-        "logs/gather_dst_channel/gather_dst_channel.log",
+        LOGS + "/gather_dst_channel/gather_dst_channel.log",
     benchmark:
-        "logs/benchmarks/gather_dst_channel/gather_dst_channel.tsv"
+        LOGS + "/benchmarks/gather_dst_channel/gather_dst_channel.tsv"
     params:
         sets=[job.name for job in DST_CHANNEL],
         code=CODE_DST["channel_gather"],
@@ -208,9 +208,9 @@ rule plot_dst_channel:
             category="Discontinuous shear thickening",
         ),
     log:
-        "logs/plot_dst_channel/plot_dst_channel.log",
+        LOGS + "/plot_dst_channel/plot_dst_channel.log",
     benchmark:
-        "logs/benchmarks/plot_dst_channel/plot_dst_channel.tsv"
+        LOGS + "/benchmarks/plot_dst_channel/plot_dst_channel.tsv"
     params:
         profile_forces=DST.get("channel", {}).get("profile_forces", []),
         code=CODE_DST["channel_gather"],

@@ -13,9 +13,9 @@ rule fit_matrix:
             subcategory="{material}",
         ),
     log:
-        "logs/fit_matrix/{material}.log",
+        LOGS + "/fit_matrix/{material}.log",
     benchmark:
-        "logs/benchmarks/fit_matrix/{material}.tsv"
+        LOGS + "/benchmarks/fit_matrix/{material}.tsv"
     params:
         law=fit_law,
         sample=fit_sample,

@@ -53,9 +53,9 @@ rule simulate_startup:
     output:
         run=f"{FLOWS_DIR}/runs/startup.nc",
     log:
-        "logs/simulate_startup/startup.log",
+        LOGS + "/simulate_startup/startup.log",
     benchmark:
-        "logs/benchmarks/simulate_startup/startup.tsv"
+        LOGS + "/benchmarks/simulate_startup/startup.tsv"
     threads: FLOWS["threads"]
     params:
         job=FLOWS_STARTUP,
@@ -68,9 +68,9 @@ rule simulate_poiseuille:
     output:
         run=f"{FLOWS_DIR}/runs/poiseuille_bn-{{bingham}}.nc",
     log:
-        "logs/simulate_poiseuille/bn-{bingham}.log",
+        LOGS + "/simulate_poiseuille/bn-{bingham}.log",
     benchmark:
-        "logs/benchmarks/simulate_poiseuille/bn-{bingham}.tsv"
+        LOGS + "/benchmarks/simulate_poiseuille/bn-{bingham}.tsv"
     wildcard_constraints:
         bingham=r"[0-9.e+-]+",
     threads: FLOWS["threads"]
@@ -88,9 +88,9 @@ rule gather_flows:
     output:
         flows=f"{FLOWS_DIR}/flows.nc",
     log:
-        "logs/gather_flows/gather_flows.log",
+        LOGS + "/gather_flows/gather_flows.log",
     benchmark:
-        "logs/benchmarks/gather_flows/gather_flows.tsv"
+        LOGS + "/benchmarks/gather_flows/gather_flows.tsv"
     params:
         code=CODE_FLOWS["gather"],
     script:
@@ -103,9 +103,9 @@ rule plot_flows:
     output:
         **FLOWS_FIGURES,
     log:
-        "logs/plot_flows/plot_flows.log",
+        LOGS + "/plot_flows/plot_flows.log",
     benchmark:
-        "logs/benchmarks/plot_flows/plot_flows.tsv"
+        LOGS + "/benchmarks/plot_flows/plot_flows.tsv"
     params:
         code=CODE_FLOWS["figures"],
     script:

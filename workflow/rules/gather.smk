@@ -8,9 +8,9 @@ rule gather:
     output:
         summary=f"{RESULTS}/{{material}}/summary.nc",
     log:
-        "logs/gather/{material}.log",
+        LOGS + "/gather/{material}.log",
     benchmark:
-        "logs/benchmarks/gather/{material}.tsv"
+        LOGS + "/benchmarks/gather/{material}.tsv"
     params:
         code=CODE["gather"],
     script:
@@ -31,9 +31,9 @@ rule plot_summary:
             subcategory="{material}",
         ),
     log:
-        "logs/plot_summary/{material}.log",
+        LOGS + "/plot_summary/{material}.log",
     benchmark:
-        "logs/benchmarks/plot_summary/{material}.tsv"
+        LOGS + "/benchmarks/plot_summary/{material}.tsv"
     params:
         sample=fit_sample,
         code=CODE["plot_summary"],

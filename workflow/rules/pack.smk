@@ -9,7 +9,7 @@ rule pack:
     output:
         packing=f"{RESULTS}/{{material}}/packings/phi-{{phi}}_seed-{{seed}}.nc",
     log:
-        "logs/pack/{material}/phi-{phi}_seed-{seed}.log",
+        LOGS + "/pack/{material}/phi-{phi}_seed-{seed}.log",
     cache: True
     params:
         volume_fraction=run_volume_fraction,

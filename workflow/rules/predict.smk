@@ -13,9 +13,9 @@ rule predict_homogenisation:
             subcategory="{material}",
         ),
     log:
-        "logs/predict_homogenisation/{material}.log",
+        LOGS + "/predict_homogenisation/{material}.log",
     benchmark:
-        "logs/benchmarks/predict_homogenisation/{material}.tsv"
+        LOGS + "/benchmarks/predict_homogenisation/{material}.tsv"
     params:
         volume_fractions=volume_fractions,
         phi_max=config["homogenisation"]["phi_max"],

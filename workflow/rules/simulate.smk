@@ -9,9 +9,9 @@ rule simulate:
     output:
         run=f"{RESULTS}/{{material}}/runs/phi-{{phi}}_rate-{{rate}}_seed-{{seed}}.nc",
     log:
-        "logs/simulate/{material}/phi-{phi}_rate-{rate}_seed-{seed}.log",
+        LOGS + "/simulate/{material}/phi-{phi}_rate-{rate}_seed-{seed}.log",
     benchmark:
-        "logs/benchmarks/simulate/{material}/phi-{phi}_rate-{rate}_seed-{seed}.tsv"
+        LOGS + "/benchmarks/simulate/{material}/phi-{phi}_rate-{rate}_seed-{seed}.tsv"
     threads: SIMULATION["threads"]
     params:
         shear_rate=run_shear_rate,

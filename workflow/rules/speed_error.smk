@@ -50,9 +50,9 @@ rule speed_error_measure:
     output:
         record=f"{SPEED_ERROR_DIR}/runs/{{case}}/{{configuration}}.nc",
     log:
-        "logs/speed_error_measure/{case}/{configuration}.log",
+        LOGS + "/speed_error_measure/{case}/{configuration}.log",
     benchmark:
-        "logs/benchmarks/speed_error_measure/{case}/{configuration}.tsv"
+        LOGS + "/benchmarks/speed_error_measure/{case}/{configuration}.tsv"
     wildcard_constraints:
         case=r"[a-z0-9_.]+",
         configuration=r"[A-Za-z0-9_.+-]+",
@@ -70,9 +70,9 @@ rule speed_error_gather:
     output:
         case=f"{SPEED_ERROR_DIR}/{{case}}.nc",
     log:
-        "logs/speed_error_gather/{case}.log",
+        LOGS + "/speed_error_gather/{case}.log",
     benchmark:
-        "logs/benchmarks/speed_error_gather/{case}.tsv"
+        LOGS + "/benchmarks/speed_error_gather/{case}.tsv"
     wildcard_constraints:
         case=r"[a-z0-9_.]+",
     params:
@@ -92,9 +92,9 @@ rule speed_error_report:
         ),
         table=f"{SPEED_ERROR_DIR}/cost_table.md",
     log:
-        "logs/speed_error_report/report.log",
+        LOGS + "/speed_error_report/report.log",
     benchmark:
-        "logs/benchmarks/speed_error_report/report.tsv"
+        LOGS + "/benchmarks/speed_error_report/report.tsv"
     params:
         code=CODE["speed_error_report"],
     script:
