@@ -12,19 +12,15 @@ from __future__ import annotations
 import json
 import logging
 import os
-import shlex
-import sys
-from datetime import datetime, timezone
 from typing import Mapping, Sequence
 
 import numpy as np
 import xarray as xr
 
 from ..errors import InputError
-from ..io.atomic import atomic_path, save_figure
-from ..io.provenance import provenance
+from ..io.atomic import save_figure
+from ..io.grouped import read_grouped, write_grouped
 from ..plotting.dst_channel import plot_channel_flow, plot_channel_profiles
-from .dst_channel import encoding
 from .dst_gather import load_runs
 
 log = logging.getLogger(__name__)
@@ -70,34 +66,18 @@ def write_groups(path: str | os.PathLike, datasets: Mapping[str, xr.Dataset], *,
     """One netCDF4 group per run set under a root group of global attributes (CF
     ``Conventions``, ``title``, ``source``, ``history``, ``groups``, ``wall_time_s`` [s],
     ``completed`` and the provenance), written atomically."""
-    prov = provenance()
     phis = sorted({float(d.attrs["phi"]) for d in datasets.values()})
-    command = shlex.join(sys.argv) if command is None else command
-    root = xr.Dataset(attrs={
-        "Conventions": "CF-1.10",
-        "title": "2D SPH channel flow of a Wyart-Cates suspension at phi = "
-                 f"{', '.join(f'{p:g}' for p in phis)} against the local ODE and the "
-                 "inverse-biviscous model",
-        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), "
-                  "suspsim.stages.dst_channel",
-        "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')}: {command}",
-        "groups": " ".join(datasets),
-        "wall_time_s": float(sum(d.attrs["wall_time_s"] for d in datasets.values())),
-        "completed": 1, **prov})
-    with atomic_path(path) as tmp:
-        root.to_netcdf(tmp, mode="w", engine="netcdf4")
-        for name, data in datasets.items():
-            data.to_netcdf(tmp, mode="a", group=name, engine="netcdf4", encoding=encoding())
+    write_grouped(path, datasets, command=command, module="suspsim.stages.dst_channel",
+                  title="2D SPH channel flow of a Wyart-Cates suspension at phi = "
+                        f"{', '.join(f'{p:g}' for p in phis)} against the local ODE and the "
+                        "inverse-biviscous model",
+                  attrs={"wall_time_s": float(sum(d.attrs["wall_time_s"]
+                                                  for d in datasets.values()))})
 
 
 def read_groups(path: str | os.PathLike) -> dict[str, xr.Dataset]:
     """The run sets of a file of :func:`write_groups`, by name (InputError naming the file)."""
-    try:
-        with xr.open_dataset(path) as root:
-            groups = root.attrs["groups"].split()
-        return {g: xr.load_dataset(path, group=g) for g in groups}
-    except (OSError, ValueError, KeyError) as err:
-        raise InputError(str(path), f"cannot read the channel sets: {err}") from err
+    return read_grouped(path, "the channel sets")
 
 
 def write_channel_figures(channel_nc: str | os.PathLike, outputs: Mapping[str, str], *,

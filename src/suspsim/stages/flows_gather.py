@@ -9,17 +9,13 @@ from __future__ import annotations
 
 import logging
 import os
-import shlex
-import sys
-from datetime import datetime, timezone
 from typing import Sequence
 
 import numpy as np
 import xarray as xr
 
 from ..errors import InputError
-from ..io.atomic import atomic_path
-from ..io.provenance import provenance
+from ..io.grouped import read_grouped, write_grouped
 from ..io.variables import simulation_units
 
 log = logging.getLogger(__name__)
@@ -104,29 +100,12 @@ def write_flows(out_nc: str | os.PathLike, *, startup: str | os.PathLike | None 
     if not datasets:
         raise InputError("flows", "nothing to gather: neither startup.strains nor "
                          "poiseuille.binghams lists a run")
-    prov = provenance()
-    command = shlex.join(sys.argv) if command is None else command
-    root = xr.Dataset(attrs={
-        "Conventions": "CF-1.10",
-        "title": "Seed 000 Figs. 1-2: SPH start-up of Couette flow and split-force Poiseuille "
-                 "flow of a Papanastasiou fluid against 1D numerical solutions",
-        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), "
-                  "suspsim.stages.flows",
-        "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')}: {command}",
-        "groups": " ".join(datasets), "completed": 1, **prov})
-    with atomic_path(out_nc) as tmp:
-        root.to_netcdf(tmp, mode="w", engine="netcdf4")
-        for name, data in datasets.items():
-            encoding = {c: {"_FillValue": None} for c in data.coords}
-            data.to_netcdf(tmp, mode="a", group=name, engine="netcdf4", encoding=encoding)
+    write_grouped(out_nc, datasets, command=command, module="suspsim.stages.flows",
+                  title="Seed 000 Figs. 1-2: SPH start-up of Couette flow and split-force "
+                        "Poiseuille flow of a Papanastasiou fluid against 1D numerical solutions")
     log.info("wrote %s: %s", out_nc, ", ".join(datasets))
 
 
 def read_flows(path: str | os.PathLike) -> dict[str, xr.Dataset]:
     """The parts of a file of :func:`write_flows`, by group name (InputError naming the file)."""
-    try:
-        with xr.open_dataset(path) as root:
-            groups = root.attrs["groups"].split()
-        return {g: xr.load_dataset(path, group=g) for g in groups}
-    except (OSError, ValueError, KeyError) as err:
-        raise InputError(str(path), f"cannot read the flows study: {err}") from err
+    return read_grouped(path, "the flows study")
