@@ -17,18 +17,13 @@ that flow-curve Dataset; the root group has the global attributes) and
 """
 import argparse
 import logging
-import shlex
-import sys
 import time
-from datetime import datetime, timezone
 from pathlib import Path
-
-import xarray as xr
 
 from suspsim.dst.parameters import WyartCatesFluid
 from suspsim.dst.study import SEED_002, STRONG_NONLOCALITY, flow_curve, spanning_stresses
-from suspsim.io.atomic import atomic_path, save_figure
-from suspsim.io.provenance import provenance
+from suspsim.io.atomic import save_figure
+from suspsim.io.grouped import read_grouped, write_grouped
 from suspsim.plotting.dst import plot_flow_curves
 
 HERE = Path(__file__).resolve().parent
@@ -38,21 +33,11 @@ VOLUME_FRACTIONS = (0.48, 0.50, 0.54)
 
 def write_groups(path, datasets, total_wall_time):
     """One netCDF4 group per dataset (``phi-<φ>``) under a root group of global attributes."""
-    prov = provenance()
-    root = xr.Dataset(attrs={
-        "Conventions": "CF-1.10",
-        "title": "Stress-controlled 2D SPH DST flow curves (Wyart-Cates), strong non-locality",
-        "source": f"suspsim {prov['suspsim_version']} (git {prov['git_sha']}), "
-                  "docs/figures/make_dst_flow_curves.py",
-        "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')}: "
-                   f"{shlex.join(sys.argv)}",
-        "groups": " ".join(_group(d) for d in datasets),
-        "wall_time_s": total_wall_time, "completed": 1, **prov})
-    with atomic_path(path) as tmp:
-        root.to_netcdf(tmp, mode="w", engine="netcdf4")
-        for data in datasets:
-            data.to_netcdf(tmp, mode="a", group=_group(data), engine="netcdf4",
-                           encoding={"stress": {"_FillValue": None}})
+    write_grouped(path, {_group(d): d for d in datasets},
+                  title="Stress-controlled 2D SPH DST flow curves (Wyart-Cates), strong "
+                        "non-locality",
+                  module="docs/figures/make_dst_flow_curves.py",
+                  attrs={"wall_time_s": total_wall_time})
 
 
 def _group(data):
@@ -88,9 +73,7 @@ def main() -> None:
                         help="redraw the figure and table from the existing .nc, no runs")
     args = parser.parse_args()
     if args.plot_only:
-        with xr.open_dataset(NETCDF) as root:
-            groups = root.attrs["groups"].split()
-        datasets = [xr.load_dataset(NETCDF, group=g) for g in groups]
+        datasets = list(read_grouped(NETCDF, "the DST flow curves").values())
         for data in datasets:
             _table(data)
         save_figure(plot_flow_curves(datasets), FIGURE)
