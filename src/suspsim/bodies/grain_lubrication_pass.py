@@ -47,7 +47,7 @@ from .grain_contacts import (C_A, C_B, CONTACT_WIDTH, GAP, INDEX_A, INDEX_B, RAD
                              grain_pair_contact)
 from .lubrication import curved_squeeze_coefficient_frames, gap_viscosity, sphere_squeeze_law
 from .lubrication_implicit import lubrication_pair_impulse_law
-from .lubrication_pass import OVERLAPS, PAIRS, SMALLEST_GAP
+from .lubrication_pass import OVERLAPS, PAIRS, SMALLEST_GAP, record_pair
 
 __all__ = ["grain_lubrication_pass", "grain_pair_impulse"]
 
@@ -195,9 +195,6 @@ def grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments
                                        principal_curvatures[q, kb, 0],
                                        principal_curvatures[q, kb, 1], dt, law_code, law_params,
                                        cutoff_gap, min_gap, repulsion_strength, out)
-            stats[PAIRS] += 1.0
-            if s_new <= 0.0:
-                stats[OVERLAPS] += 1.0
             for k in range(3):
                 velocities[p, k] += out[0, k] / mass[p]
                 velocities[q, k] += out[1, k] / mass[q]
@@ -206,9 +203,4 @@ def grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments
                                  + inv_inertia[p, k, 2] * out[2, 2])
                 omegas[q, k] += (inv_inertia[q, k, 0] * out[3, 0] + inv_inertia[q, k, 1] * out[3, 1]
                                  + inv_inertia[q, k, 2] * out[3, 2])
-            fx, fy, fz = out[0, 0] / dt, out[0, 1] / dt, out[0, 2] / dt
-            virial[0] += fx * dx
-            virial[1] += fy * dy
-            virial[2] += fz * dz
-            virial[3] += fx * dy
-            virial[4] += fy * dx
+            record_pair(s_new, out, dt, dx, dy, dz, virial, stats)

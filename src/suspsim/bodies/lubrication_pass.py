@@ -74,17 +74,24 @@ def lubrication_pass(centres, radii, velocities, omegas, mass, inertia, box, le_
                                              omegas[p], omegas[q], zero, zero, zero, zero,
                                              mass[p], mass[q], inertia[p], inertia[q], dt, mu,
                                              cutoff_gap, min_gap, repulsion_strength, out)
-            stats[PAIRS] += 1.0
-            if s_new <= 0.0:
-                stats[OVERLAPS] += 1.0
             for k in range(3):
                 velocities[p, k] += out[0, k] / mass[p]
                 velocities[q, k] += out[1, k] / mass[q]
                 omegas[p, k] += out[2, k] / inertia[p]
                 omegas[q, k] += out[3, k] / inertia[q]
-            fx, fy, fz = out[0, 0] / dt, out[0, 1] / dt, out[0, 2] / dt
-            virial[0] += fx * dx
-            virial[1] += fy * dy
-            virial[2] += fz * dz
-            virial[3] += fx * dy
-            virial[4] += fy * dx
+            record_pair(s_new, out, dt, dx, dy, dz, virial, stats)
+
+
+@njit(**JIT_OPTIONS)
+def record_pair(s_new, out, dt, dx, dy, dz, virial, stats):
+    """Count a treated pair (and a predicted overlap when ``s_new`` ≤ 0) in ``stats`` and add
+    its step-mean force ``out[0]``/δt ⊗ r₁₂ = (dx, dy, dz) to ``virial`` (module docstring)."""
+    stats[PAIRS] += 1.0
+    if s_new <= 0.0:
+        stats[OVERLAPS] += 1.0
+    fx, fy, fz = out[0, 0] / dt, out[0, 1] / dt, out[0, 2] / dt
+    virial[0] += fx * dx
+    virial[1] += fy * dy
+    virial[2] += fz * dz
+    virial[3] += fx * dy
+    virial[4] += fy * dx
