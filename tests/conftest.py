@@ -11,5 +11,5 @@ if os.environ.get("PYTEST_XDIST_WORKER"):
 
 # Shared fixtures are session-scoped, not module-scoped: with --dist loadgroup a worker runs the
 # tests of several modules interleaved, and a module fixture is torn down whenever the worker
-# leaves its module, so an expensive one was rebuilt (the DST split run, 249 s, and the report
-# study, 72-77 s, twice each in the reduced CI suite). A fixture stays visible to its own module.
+# leaves its module. Tests that share an expensive fixture also carry one xdist_group mark, so
+# that one worker builds it once (that needs pytest < 9: see pyproject.toml).
