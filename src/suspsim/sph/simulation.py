@@ -349,9 +349,10 @@ class Simulation:
                                       g["centre_shift"], g["body_to_principal"])
         return spec.cutoff_gap, spec.min_gap, strength, self.bodies.moments.mean(axis=1), surfaces
 
-    def _lubricate(self, time: float) -> None:
+    def _lubricate(self, time: float, rotations) -> None:
         """Implicit lubrication impulses on the kicked bodies (``bodies.lubrication_pass``;
-        grains at their closest points, ``bodies.grain_lubrication_pass``)."""
+        grains at their closest points, ``bodies.grain_lubrication_pass``, with ``rotations``
+        the step's orientations (B, 3, 3))."""
         bodies, law = self.bodies, self.scene.fluid.law
         cutoff, min_gap, strength, inertia, surfaces = self._lubrication
         omegas = bodies.angular_velocities()
@@ -362,7 +363,7 @@ class Simulation:
                              self._lubrication_virial, self._lubrication_stats)
         else:
             sf = surfaces
-            grain_lubrication_pass(bodies.centres, bodies.rotations(), bodies.velocities, omegas,
+            grain_lubrication_pass(bodies.centres, rotations, bodies.velocities, omegas,
                                    bodies.mass, bodies.moments, self._box, self._offset(time),
                                    self._rate, self.dt, law.code, law.packed, cutoff, min_gap,
                                    strength, sf.points, sf.normals, sf.first_directions,
@@ -401,7 +402,7 @@ class Simulation:
             if bodies is not None:
                 bodies.kick(*self._body_forces(rotations), dt)
                 if self._lubrication is not None:
-                    self._lubricate(time)
+                    self._lubricate(time, rotations)
                 self._place_bodies(rotations, bodies.velocities, bodies.angular_velocities(),
                                    time, self._v)
             if self._shifting > 0.0:
