@@ -147,11 +147,14 @@ def grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments
     u2 = np.zeros(3)
     inv_inertia = np.zeros((n, 3, 3))
     scalar = np.zeros(n)
+    # the centroids lie within |centroid| of the centres of mass
+    extra = np.zeros(n)
     e1a = np.zeros(3)
     e1b = np.zeros(3)
     for b in range(n):
         _inverse_inertia(rotations[b], moments[b], inv_inertia[b])
         scalar[b] = (moments[b, 0] + moments[b, 1] + moments[b, 2]) / 3.0
+        extra[b] = np.sqrt(centroids[b, 0] ** 2 + centroids[b, 1] ** 2 + centroids[b, 2] ** 2)
     virial[:] = 0.0
     stats[SMALLEST_GAP] = np.inf
     stats[PAIRS] = 0.0
@@ -162,10 +165,7 @@ def grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments
                                                  centres[p, 1] - centres[q, 1],
                                                  centres[p, 2] - centres[q, 2],
                                                  lx, ly, lz, le_offset)
-            # the centroids lie within |centroid| of the centres of mass
-            extra_p = np.sqrt(centroids[p, 0] ** 2 + centroids[p, 1] ** 2 + centroids[p, 2] ** 2)
-            extra_q = np.sqrt(centroids[q, 0] ** 2 + centroids[q, 1] ** 2 + centroids[q, 2] ** 2)
-            far = reach[p] + reach[q] + extra_p + extra_q + cutoff_gap
+            far = reach[p] + reach[q] + extra[p] + extra[q] + cutoff_gap
             if dx * dx + dy * dy + dz * dz >= far * far:
                 continue
             r12[0], r12[1], r12[2] = dx, dy, dz
