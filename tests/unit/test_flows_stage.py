@@ -220,3 +220,18 @@ def test_plot_poiseuille_normalises_by_the_newtonian_maximum(tmp_path):
     error = 100 * float(data["profile_error"][1])
     assert 0.5 < error < 2 and labels == ["Bn = 0: L2/peak = 0.0 %",
                                           f"Bn = 1: L2/peak = {error:.1f} %"]
+
+
+def test_unhealthy_startup_stops_and_writes_nothing(tmp_path, monkeypatch):
+    """A start-up that ended outside its health limits raises NumericalError with the health
+    message, and leaves no run file (its profiles would be a blow-up's)."""
+    from suspsim.errors import NumericalError
+    from suspsim.stages import flows
+
+    blown = fake_startup(0.0)
+    blown.attrs.update(healthy=0, health="Mach number 0.4 exceeds run.max_mach 0.3 at step 9")
+    monkeypatch.setattr(flows, "papanastasiou_startup", lambda **job: blown)
+    out = tmp_path / "startup.nc"
+    with pytest.raises(NumericalError, match="Bn 0.1: Mach number 0.4 exceeds run.max_mach"):
+        flows.simulate_startup(startup_job(_flows_block("flows_smoke")), out)
+    assert list(tmp_path.iterdir()) == []

@@ -40,7 +40,7 @@ from typing import Any, Mapping
 import numpy as np
 import xarray as xr
 
-from ..errors import InputError
+from ..errors import InputError, NumericalError
 from ..io.atomic import atomic_path
 from ..io.provenance import provenance
 from ..io.variables import UNIT_SYSTEM, simulation_units
@@ -139,10 +139,13 @@ def poiseuille_scene(job: Mapping[str, Any]) -> dict:
 
 def simulate_startup(job: Mapping[str, Any], out_nc: str | os.PathLike, *,
                      threads: int = 1) -> None:
-    """Run the start-up of ``job`` (:func:`startup_job`) and write its Dataset atomically."""
+    """Run the start-up of ``job`` (:func:`startup_job`) and write its Dataset atomically.
+
+    Raises NumericalError, writing nothing, when the run ended outside its health limits (as
+    the channel runs do): its profiles would be a blow-up's."""
     data = papanastasiou_startup(threads=threads, **job)
     if not data.attrs["healthy"]:
-        log.warning("start-up left its health limits: %s", data.attrs["health"])
+        raise NumericalError(f"start-up at Bn {job['bingham']:g}: {data.attrs['health']}")
     with atomic_path(out_nc) as tmp:
         data.to_netcdf(tmp, engine="netcdf4")
     errors = ", ".join(f"{s:.3g}: {100 * e:.2f} %" for s, e in
