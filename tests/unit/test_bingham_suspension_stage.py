@@ -145,11 +145,12 @@ def test_cot_estimate_is_the_formula_by_hand():
     assert plastic == pytest.approx(math.sqrt(g * (1 - phi)), rel=1e-6)
 
 
-def synthetic_run(block, rate, seed, eta, error, wall=2.0):
+def synthetic_run(block, rate, seed, eta, error, wall=2.0, packing=None):
     """A run Dataset of ``rate`` (None: Newtonian) and ``seed`` with relative viscosity
-    ``eta`` ± ``error``, as suspsim's run file holds it."""
+    ``eta`` ± ``error``, as suspsim's run file holds it, on the packing file ``packing``
+    (default packings/seed-<seed>.nc)."""
     job = find_job(block, case_name(rate), seed)
-    scene = scene_from_dict(suspension_scene(job, f"packings/seed-{seed}.nc"))
+    scene = scene_from_dict(suspension_scene(job, packing or f"packings/seed-{seed}.nc"))
     return xr.Dataset({"phi": ((), float(block["volume_fraction"])),
                        "relative_viscosity": ((), eta),
                        "relative_viscosity_stderr": ((), error)},
@@ -211,11 +212,16 @@ def test_gather_seed_mean_of_g_has_block_errors_and_seed_scatter():
                                cot_relative_viscosity([1.0], 99.0, 0.4, 5.2), rtol=1e-12)
 
 
-def test_gather_refuses_a_run_of_other_settings_and_a_missing_run():
+def test_gather_refuses_a_run_of_other_settings_or_packing_and_a_missing_run():
     newtonian = [synthetic_run(BLOCK, None, 1, 5.0, 0.2)]
     runs = [synthetic_run(BLOCK, 1.0, 1, 2.5, 0.1), synthetic_run(BLOCK, 1.0, 1, 2.5, 0.1)]
-    with pytest.raises(InputError, match=r"x-100_seed-1.nc: run of other settings.*M 250"):
+    with pytest.raises(InputError, match=r"x-100_seed-1.nc: not the config's run.*M 250"):
         gather_suspension(BLOCK, newtonian, runs, newtonian_sources=["newtonian_seed-1.nc"],
+                          sources=["x-1_seed-1.nc", "x-100_seed-1.nc"])
+    other = [runs[0], synthetic_run(BLOCK, 100.0, 1, 2.5, 0.1, packing="elsewhere/seed-1.nc")]
+    with pytest.raises(InputError, match=r"x-100_seed-1.nc: .*packing 'elsewhere/seed-1.nc' "
+                                         r"\(expected 'packings/seed-1.nc'\)"):
+        gather_suspension(BLOCK, newtonian, other, newtonian_sources=["newtonian_seed-1.nc"],
                           sources=["x-1_seed-1.nc", "x-100_seed-1.nc"])
     with pytest.raises(InputError, match="1 Papanastasiou run.*2 rate"):
         gather_suspension(BLOCK, newtonian, runs[:1], newtonian_sources=["n.nc"],

@@ -37,8 +37,7 @@ from ..io.variables import UNIT_SYSTEM, simulation_units
 from ..plotting.summary import seed_mean
 from ..rheology.laws import make_law
 from ..rheology.suspension import chateau_ovarlez_trung_viscosity
-from .bingham_suspension import (BLOCK, matrix_law, matrix_plastic_ratio,
-                                 study_settings)
+from .bingham_suspension import BLOCK, matrix_law, matrix_plastic_ratio, study_settings
 
 log = logging.getLogger(__name__)
 
@@ -81,28 +80,32 @@ def _attrs(long_name: str, powers=None, **more) -> dict:
     return out
 
 
-def _check_run(run: xr.Dataset, source: str, job: Mapping[str, Any]) -> None:
+def _check_run(run: xr.Dataset, source: str, job: Mapping[str, Any],
+               packing: str | None = None) -> None:
     """InputError naming ``source`` unless the run is the job's scene (law, rate, φ, box,
-    number density, strain, seed) and has a relative viscosity."""
+    number density, strain, seed), read the packing file ``packing`` (when given: its seed's
+    Newtonian run's, so that both have the same spheres) and has a relative viscosity."""
     if "relative_viscosity" not in run:
         raise InputError(source, "not a run with inclusions: no relative_viscosity")
     scene = json.loads(run.attrs["scene"])
     name, params = matrix_law(job["rate"], job["viscosity_ratio"], job["shear_rate"])
-    wanted = {"law": name, **params, "shear_rate": job["shear_rate"], "phi": job["volume_fraction"],
-              "box": job["box"], "number_density": job["number_density"],
-              "strain": job["strain"], "seed": job["seed"]}
+    wanted = {"law": name, **params, "shear_rate": job["shear_rate"],
+              "phi": job["volume_fraction"], "box": job["box"], "number_density": job["number_density"],
+              "strain": job["strain"], "seed": job["seed"],
+              **({} if packing is None else {"packing": packing})}
     found = {"law": scene["fluid"]["law"], **scene["fluid"]["params"],
              "shear_rate": scene["flow"]["shear_rate"], "phi": float(run["phi"]),
              "box": scene["box"][0], "number_density": scene["number_density"],
-             "strain": scene["run"]["strain"], "seed": scene["inclusions"]["seed"]}
+             "strain": scene["run"]["strain"], "seed": scene["inclusions"]["seed"],
+             "packing": scene["inclusions"]["packing"]}
     wrong = [key for key, value in wanted.items()
-             if (found.get(key) != value if isinstance(value, str) else
+             if (found.get(key) != value if isinstance(value, str) or value is None else
                  not math.isclose(float(found.get(key, math.nan)), float(value),
                                   rel_tol=SCENE_MATCH))]
     if wrong:
-        details = ", ".join(f"{key} {found.get(key)!r} (the config's {wanted[key]!r})"
+        details = ", ".join(f"{key} {found.get(key)!r} (expected {wanted[key]!r})"
                             for key in wrong)
-        raise InputError(source, f"run of other settings than the config's: {details}; "
+        raise InputError(source, f"not the config's run on its seed's packing: {details}; "
                          "re-run its simulate job")
 
 
@@ -124,9 +127,10 @@ def gather_suspension(block: Mapping[str, Any], newtonian: Sequence[xr.Dataset],
     shared = {key: settings[key] for key in settings if key not in ("rates", "seeds", "threads")}
     for run, source, seed in zip(newtonian, newtonian_sources, seeds):
         _check_run(run, source, {**shared, "rate": None, "seed": seed})
+    packings = [json.loads(run.attrs["scene"])["inclusions"]["packing"] for run in newtonian]
     for k, (run, source) in enumerate(zip(runs, sources)):
         _check_run(run, source, {**shared, "rate": rates[k // len(seeds)],
-                                 "seed": seeds[k % len(seeds)]})
+                                 "seed": seeds[k % len(seeds)]}, packings[k % len(seeds)])
 
     def table(name: str) -> np.ndarray:
         return np.array([float(run[name]) for run in runs]).reshape(len(rates), len(seeds))
