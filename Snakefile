@@ -19,6 +19,7 @@ include: "workflow/rules/gather.smk"
 include: "workflow/rules/speed_error.smk"
 include: "workflow/rules/dst.smk"
 include: "workflow/rules/flows.smk"
+include: "workflow/rules/bingham_suspension.smk"
 
 
 rule all:
