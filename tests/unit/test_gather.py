@@ -9,8 +9,8 @@ from matplotlib.figure import Figure
 from suspsim.errors import InputError
 from suspsim.io.study_variables import STUDY_VARIABLES, SUMMARY_DIMS
 from suspsim.plotting.shapes import plot_shape_comparison, shape_ratio
-from suspsim.plotting.summary import (plot_relative_viscosity_vs_phi, plot_summary,
-                                      plot_viscosity, seed_mean)
+from suspsim.analysis.seeds import seed_mean
+from suspsim.plotting.summary import plot_relative_viscosity_vs_phi, plot_summary, plot_viscosity
 from suspsim.rheology.laws import make_law
 from suspsim.stages.gather import gather_runs, write_summary
 from suspsim.stages.homogenisation import homogenisation_estimate

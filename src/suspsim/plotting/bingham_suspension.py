@@ -4,7 +4,7 @@ from __future__ import annotations
 import xarray as xr
 from matplotlib.figure import Figure
 
-from .summary import seed_mean
+from ..analysis.seeds import seed_mean
 
 
 def plot_bingham_suspension(data: xr.Dataset) -> Figure:
@@ -12,7 +12,7 @@ def plot_bingham_suspension(data: xr.Dataset) -> Figure:
 
     (a) As seed 000 plots it: viscosity over the matrix's plastic (infinite-rate) viscosity
     against x, the matrix law μ_m/μ_pl as a line and the suspension η/μ_pl as points with
-    their errors (seed mean, :func:`~suspsim.plotting.summary.seed_mean`).
+    their errors (seed mean, :func:`~suspsim.analysis.seeds.seed_mean`).
     (b) η/μ_m(γ̇) against x with the Chateau–Ovarlez–Trung estimate (line, band from g ± its
     error) and the Newtonian g (horizontal line, its error shaded).
     """

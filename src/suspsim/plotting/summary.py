@@ -2,11 +2,7 @@
 
 Input is a gathered summary (:func:`suspsim.stages.gather.gather_runs`, dims phi, shear_rate,
 seed). Each φ is one colour: the mean over seeds with an error bar combining the runs' standard
-errors and the spread between seeds,
-
-    η̄ = (1/n) Σ η_i,    s² = (1/n²) Σ s_i² + Var_seeds(η)/n    (Var = 0 for one seed),
-
-drawn over the fitted matrix law (line), the measured matrix points (open circles) and, for φ > 0,
+errors and the spread between seeds (:func:`suspsim.analysis.seeds.seed_mean`), drawn over the fitted matrix law (line), the measured matrix points (open circles) and, for φ > 0,
 the homogenisation estimate of the same φ (dashed) when one is given. The relative viscosity
 η_r = η/μ_m(γ̇) is drawn against γ̇ per φ (φ = 0 checks the solver: 1) and against φ per γ̇, there
 beside the estimate's η_r(φ) at each simulated rate (dashed, interpolated in log γ̇ when the
@@ -23,6 +19,7 @@ from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from ..analysis.seeds import seed_mean
 from ..rheology.laws import ConstitutiveLaw
 
 #: The fitted-law line spans the plotted rates widened by this factor at each end.
@@ -33,16 +30,6 @@ PHI_TOLERANCE = 1e-9
 RATE_TOLERANCE = 1e-9
 #: Colour map of the shear rates in the η_r(φ) panel, low rate dark.
 RATE_COLOURS = "viridis"
-
-
-def seed_mean(summary: xr.Dataset, name: str) -> tuple[xr.DataArray, xr.DataArray]:
-    """Mean of ``name`` over seeds and its error (module docstring); NaN runs are skipped."""
-    values, errors = summary[name], summary[f"{name}_stderr"]
-    n = values.notnull().sum("seed")
-    mean = values.mean("seed")
-    spread = values.var("seed", ddof=1).fillna(0.0) if summary.sizes["seed"] > 1 else 0.0 * mean
-    error = np.sqrt((errors ** 2).sum("seed") / n ** 2 + spread / n)
-    return mean.where(n > 0), error.where(n > 0)
 
 
 def plot_viscosity(summary: xr.Dataset, ax: Axes | None = None, *,

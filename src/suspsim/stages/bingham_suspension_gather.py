@@ -7,7 +7,7 @@ each (x, seed) and writes one netCDF file on dimensions (``rate``, ``seed``)
     η/μ_m(γ̇)   the runs' ``relative_viscosity`` ± stderr (block averages of the run)
     η/μ_pl     = η/μ_m(γ̇) · μ_m/μ_pl, μ_m/μ_pl = 1 + r (1 − e^(−x))/x
     g          the Newtonian runs' relative viscosity ± stderr, per seed; ḡ its seed mean with
-               the error of :func:`suspsim.plotting.summary.seed_mean` (block errors and
+               the error of :func:`suspsim.analysis.seeds.seed_mean` (block errors and
                seed scatter)
 
 and the Chateau–Ovarlez–Trung estimate at each x (:func:`cot_relative_viscosity`, from ḡ),
@@ -30,11 +30,11 @@ import numpy as np
 import xarray as xr
 
 from ..errors import InputError
+from ..analysis.seeds import seed_mean
 from ..io.atomic import atomic_path
 from ..io.netcdf import read_run
 from ..io.provenance import provenance
 from ..io.variables import UNIT_SYSTEM, simulation_units
-from ..plotting.summary import seed_mean
 from ..rheology.laws import make_law
 from ..rheology.suspension import chateau_ovarlez_trung_viscosity
 from .bingham_suspension import BLOCK, matrix_law, matrix_plastic_ratio, study_settings
@@ -172,7 +172,7 @@ def gather_suspension(block: Mapping[str, Any], newtonian: Sequence[xr.Dataset],
             "seed mean of the Newtonian relative viscosity g")),
         "newtonian_relative_viscosity_mean_stderr": ((), g_mean_err, _attrs(
             "standard error of the seed mean of g (block errors and seed scatter, "
-            "suspsim.plotting.summary.seed_mean)")),
+            "suspsim.analysis.seeds.seed_mean)")),
         "cot_relative_viscosity": ("rate", cot, _attrs(cot_name)),
         "cot_relative_viscosity_low": ("rate", cot_low, _attrs(
             "lower edge of the COT estimate for g = mean -/+ its standard error")),
