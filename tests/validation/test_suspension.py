@@ -146,9 +146,11 @@ def test_bingham_matrix_follows_homogenisation(x):
     the Newtonian η_r of the same packing; and at x = 1, where the yield stress dominates, well
     below g (seed 000: "only about a factor of two to three higher" than the matrix).
 
-    Measured (``suspsim run``, strain 1-5, one seed, g = 3.54): η_r = 3.35, 2.94, 2.03, 1.72,
-    2.50 at x = 0.01, 0.1, 1, 10, 100 against COT 3.51, 3.30, 2.12, 1.65, 2.50 (−5 … +4 %,
-    −11 % at 0.1); g with the non-Newtonian shifting A = 3 instead of 30: 3.47 ± 0.16."""
+    Measured (the ``bingham_suspension`` study's packing, strain 2–10, g = 3.70 ± 0.12):
+    η_r = 3.80, 2.00, 2.76 at x = 0.01, 1, 100 against COT 3.68, 2.19, 2.60, and within
+    −8.4 … +7.6 % at all 11 rates from 0.01 to 1000; this test's packing at CI size (strain 1–4)
+    x = 1: 1.975 against 2.133. g with the non-Newtonian shifting A = 3 instead of the
+    Newtonian default 30: 3.47 ± 0.16 against 3.54 ± 0.12 (strain 1–5)."""
     phi = 0.4
     name, params = matrix_law(x, 99.0, RATE)
     law = make_law(name, params)
