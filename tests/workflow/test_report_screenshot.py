@@ -93,7 +93,7 @@ def report(tmp_path_factory):
 
 #: Rule files of the studies that are not the material pipeline (their figures are not in the
 #: smoke study's report, and their own workflow tests run them).
-OTHER_STUDIES = {"speed_error", "dst", "flows"}
+OTHER_STUDIES = {"speed_error", "dst", "flows", "bingham_suspension"}
 
 
 def test_every_report_output_of_the_rules_is_parsed():
