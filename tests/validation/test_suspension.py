@@ -22,10 +22,10 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "unit" / "sph"))
 from sph_helpers import measured_viscosity_ratio  # noqa: E402
 
-from suspsim.rheology.suspension import published_envelope  # noqa: E402
-from suspsim.scene import scene_from_dict  # noqa: E402
 from suspsim.rheology.laws import make_law  # noqa: E402
-from suspsim.rheology.suspension import chateau_ovarlez_trung_viscosity  # noqa: E402
+from suspsim.rheology.suspension import (chateau_ovarlez_trung_viscosity,  # noqa: E402
+                                         published_envelope)
+from suspsim.scene import scene_from_dict  # noqa: E402
 from suspsim.scene_rules import AUTO_SHIFTING_WITH_INCLUSIONS  # noqa: E402
 from suspsim.stages.bingham_suspension import matrix_law  # noqa: E402
 

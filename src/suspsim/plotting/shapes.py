@@ -3,7 +3,8 @@ at equal volume fraction and shear rate (seed 000 Fig. 6: sand reads above spher
 
 Input: gathered summaries (:func:`suspsim.stages.gather.gather_runs`, dims phi, shear_rate,
 seed), keyed by a label ("spheres", "sand"). η_r and its error are the means over seeds of
-:func:`~suspsim.analysis.seeds.seed_mean`. The ratio of two studies' η_r at equal (φ, γ̇) carries the error
+:func:`~suspsim.analysis.seeds.seed_mean`. The ratio of two studies' η_r at equal (φ, γ̇)
+carries the error
 
     s_ratio = ratio · sqrt((s_a/η_a)² + (s_b/η_b)²)    (independent runs).
 
@@ -19,8 +20,8 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from ..rheology.suspension import published_envelope
 from ..analysis.seeds import seed_mean
+from ..rheology.suspension import published_envelope
 
 #: Largest φ the published band is drawn to [1] (the fits are meant for φ ≤ 0.5).
 BAND_MAX_PHI = 0.5

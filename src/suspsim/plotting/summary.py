@@ -2,8 +2,9 @@
 
 Input is a gathered summary (:func:`suspsim.stages.gather.gather_runs`, dims phi, shear_rate,
 seed). Each φ is one colour: the mean over seeds with an error bar combining the runs' standard
-errors and the spread between seeds (:func:`suspsim.analysis.seeds.seed_mean`), drawn over the fitted matrix law (line), the measured matrix points (open circles) and, for φ > 0,
-the homogenisation estimate of the same φ (dashed) when one is given. The relative viscosity
+errors and the spread between seeds (:func:`suspsim.analysis.seeds.seed_mean`), drawn over the
+fitted matrix law (line), the measured matrix points (open circles) and, for φ > 0, the
+homogenisation estimate of the same φ (dashed) when one is given. The relative viscosity
 η_r = η/μ_m(γ̇) is drawn against γ̇ per φ (φ = 0 checks the solver: 1) and against φ per γ̇, there
 beside the estimate's η_r(φ) at each simulated rate (dashed, interpolated in log γ̇ when the
 estimate's rates differ) and its Newtonian limit, Krieger–Dougherty g(φ) (dotted). No file I/O
