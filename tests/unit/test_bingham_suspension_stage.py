@@ -3,12 +3,10 @@ scaling of each rate, the validation errors, and the gather's numbers (η/μ_pl,
 Chateau–Ovarlez–Trung estimate) against hand calculations, on synthetic run files."""
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
-import yaml
 
 from suspsim.errors import InputError
 from suspsim.rheology.laws import make_law
@@ -20,8 +18,8 @@ from suspsim.stages.bingham_suspension_figures import write_suspension_figure
 from suspsim.stages.bingham_suspension_gather import (cot_relative_viscosity,
                                                       gather_suspension, read_suspension,
                                                       write_suspension)
+from test_flows_stage import validated_config
 
-REPO = Path(__file__).resolve().parents[2]
 #: The schema defaults of the block (seed 000's φ = 0.4, the owner's scene) with two rates.
 BLOCK = {"viscosity_ratio": 99.0, "rates": [1.0, 100.0], "volume_fraction": 0.4, "radius": 2.5,
          "box": 15.0, "number_density": 4.096, "shear_rate": 0.004, "strain": 10.0,
@@ -29,15 +27,8 @@ BLOCK = {"viscosity_ratio": 99.0, "rates": [1.0, 100.0], "volume_fraction": 0.4,
 
 
 def _block(study):
-    """The bingham_suspension block of config.yaml under ``study`` (None: config.yaml alone)
-    with the schema defaults, as the workflow sees it."""
-    from snakemake.utils import validate
-
-    config = yaml.safe_load((REPO / "config/config.yaml").read_text())
-    if study:
-        config.update(yaml.safe_load((REPO / f"config/studies/{study}.yaml").read_text()))
-    validate(config, str(REPO / "workflow/schemas/config.schema.yaml"))
-    return config["bingham_suspension"]
+    """The bingham_suspension block of the validated config of ``study``."""
+    return validated_config(study)["bingham_suspension"]
 
 
 def test_default_config_runs_nothing_and_the_studies_list_their_runs():
@@ -134,7 +125,9 @@ def test_cot_estimate_is_the_formula_by_hand():
     # g = 5, φ = 0.4, r = 99: s = sqrt(g/(1 − φ)); η_COT/μ_m = g f(x s)/f(x),
     # f(x) = 1 + r (1 − e^(−x))/x (the μ_pl and M of the law cancel).
     g, phi, s = 5.0, 0.4, math.sqrt(5.0 / 0.6)
-    f = lambda x: 1 + 99 * (1 - math.exp(-x)) / x  # noqa: E731
+    def f(x):
+        return 1 + 99 * (1 - math.exp(-x)) / x
+
     rates = [0.01, 1.0, 100.0]
     expected = [g * f(x * s) / f(x) for x in rates]
     np.testing.assert_allclose(cot_relative_viscosity(rates, 99.0, phi, g), expected, rtol=1e-12)

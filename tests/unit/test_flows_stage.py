@@ -28,16 +28,21 @@ BLOCK = {"binghams": [0.0, 10.0], "dimension": 2, "number_density": 16.0, "width
          "run_time": 0.6, "averaging": 0.15, "jitter": 0.1, "seed": 1}
 
 
-def _flows_block(study):
-    """The flows block of config.yaml under ``study`` (None: config.yaml alone) with the
-    schema defaults, as the workflow sees it."""
+def validated_config(study):
+    """config.yaml under ``study`` (None: config.yaml alone) with the schema defaults, as the
+    workflow sees it."""
     from snakemake.utils import validate
 
     config = yaml.safe_load((REPO / "config/config.yaml").read_text())
     if study:
         config.update(yaml.safe_load((REPO / f"config/studies/{study}.yaml").read_text()))
     validate(config, str(REPO / "workflow/schemas/config.schema.yaml"))
-    return config["flows"]
+    return config
+
+
+def _flows_block(study):
+    """The flows block of :func:`validated_config`."""
+    return validated_config(study)["flows"]
 
 
 def test_default_config_runs_nothing_and_the_study_configs_list_their_runs():
