@@ -365,8 +365,11 @@ CASES: dict[str, AnyCase] = {case.name: case for case in (
     papanastasiou_couette(99.0, 3), newtonian_poiseuille(3), newtonian_poiseuille(2),
     bingham_poiseuille(1.0, 3), bingham_poiseuille(3.0, 3), bingham_poiseuille(5.0, 3),
     bingham_poiseuille(10.0, 3),
-    # the blind held-out set of docs/figures/error_model/run_holdout_blind.sh: never fitted on
+    # the held-out set of docs/figures/error_model/run_holdout_blind.sh (training data since
+    # run_holdout_blind_2.sh)
     papanastasiou_couette(9.9, 2), bingham_poiseuille(7.0, 3), newtonian_poiseuille(3, 1.0),
+    # the blind held-out set of docs/figures/error_model/run_holdout_blind_2.sh: never fitted on
+    papanastasiou_couette(30.0, 3), newtonian_poiseuille(2, 0.5), bingham_poiseuille(2.0, 3),
     dst_flow_curve_point(0.54, 2.5),
     dst_flow_curve_point(0.50, 1.0))}
 

@@ -55,8 +55,8 @@ def check(case_name: str, tolerance: float, *, max_runs: int = 6,
           model: ErrorModel | None = None) -> xr.Dataset:
     """Run the comparison sweep of ``case_name`` at ``tolerance`` [1]; the Dataset (first
     configuration = the pick) carries ``tolerance``, ``expected_error``, ``expected_cost``,
-    ``picked_error_bound``, ``picked_cpu_time``, ``cheapest_meeting_cpu_time``, ``cost_ratio``
-    and ``passed`` (1/0) as attributes."""
+    ``picked_error_bound``, ``picked_cpu_time``, ``cheapest_meeting_cpu_time``, ``cost_ratio``,
+    ``passed`` (1/0) and the ``inflation`` applied to the pick [1] as attributes."""
     model = model or load_model()
     case = get_case(case_name)
     choice = pick(case, tolerance, model)
@@ -75,6 +75,7 @@ def check(case_name: str, tolerance: float, *, max_runs: int = 6,
                     expected_cost=choice.expected_cost, picked_error_bound=float(bound[0]),
                     picked_cpu_time=float(cpu[0]), cheapest_meeting_cpu_time=cheapest,
                     cost_ratio=ratio, passed=int(passed),
+                    inflation=model.inflation_of(choice.drivers),
                     error_model=json.dumps(model.provenance))
     log.info("%s at %g: picked bound %.4g (expected %.4g), cpu %.3g s, cheapest meeting %.3g s, "
              "ratio %.2f: %s", case_name, tolerance, bound[0], choice.expected_error, cpu[0],

@@ -131,7 +131,8 @@ def choose(scene: Scene, tolerance: float, model: ErrorModel | None = None
              "expected_cost_s": choice.expected_cost, "tolerance_stress_scale": scale,
              "tolerance_settings": json.dumps({k: choice.settings[k] for k in keys}),
              "tolerance_error_terms": json.dumps(choice.terms),
-             "error_model": json.dumps({**model.provenance, "inflation": model.inflation})}
+             "error_model": json.dumps({**model.provenance,
+                                       "inflation": model.inflation_of(choice.drivers)})}
     if not math.isfinite(scale):
         raise InputError(scene.source, "cannot rescale the scene")
     return chosen, choice, attrs
