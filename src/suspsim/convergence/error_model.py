@@ -78,8 +78,8 @@ Papanastasiou Couette run at C_Δx = 0.77 was 44 % off while the Bingham channel
 (:data:`GRID`), outside which runs blew up or are not measured: q < 1.5 (3D) blew up; q near
 2 (:data:`RESOLUTION_GAP`) gave 5–37 % errors in every training case (lattice shells at
 r = h); a channel with an odd number of rows across L_y (:func:`regular`); quintic blew up at
-q = 1.6 in 3D and is not modelled; Wi = 0.03 blew up; a channel whose sheared width ℓ is below :data:`MIN_SHEARED_WIDTH` (the
-Bn = 10 channel at W = 5 h, ℓ = 1.79 h, measured 31–35 %).
+q = 1.6 in 3D and is not modelled; Wi = 0.03 blew up; a channel whose sheared width ℓ is below
+:data:`MIN_SHEARED_WIDTH` (the Bn = 10 channel at W = 5 h, ℓ = 1.79 h, measured 31–35 %).
 
 Cost model: CPU seconds ≈ k_d (N q^d n_steps)^α, N particles and n_steps computed exactly from
 the scene (the automatic sound speed and time step of :mod:`suspsim.sph.timestep`), q^d ∝
