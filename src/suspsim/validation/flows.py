@@ -81,9 +81,10 @@ def poiseuille_mean_profile(sim, *, run_time: float, averaging: float
     mean = np.zeros(bins)
     for _ in range(PROFILE_SAMPLES):
         sim.advance(stride)
+        # Before binning: positions that went NaN would fail there with a bare ValueError.
+        _require_health(sim)
         profile = sim.profiles(bins)
         mean += profile["velocity_profile"] / PROFILE_SAMPLES
-    _require_health(sim)
     ref = split_force_poiseuille_profile(scene.fluid.law, scene.density * scene.flow.body_force,
                                          height, profile["y"])
     return profile["y"], mean, ref
