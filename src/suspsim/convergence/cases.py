@@ -368,8 +368,11 @@ CASES: dict[str, AnyCase] = {case.name: case for case in (
     # the held-out set of docs/figures/error_model/run_holdout_blind.sh (training data since
     # run_holdout_blind_2.sh)
     papanastasiou_couette(9.9, 2), bingham_poiseuille(7.0, 3), newtonian_poiseuille(3, 1.0),
-    # the blind held-out set of docs/figures/error_model/run_holdout_blind_2.sh: never fitted on
+    # the blind held-out set of docs/figures/error_model/run_holdout_blind_2.sh (training data
+    # since run_holdout_blind_3.sh)
     papanastasiou_couette(30.0, 3), newtonian_poiseuille(2, 0.5), bingham_poiseuille(2.0, 3),
+    # the blind held-out set of docs/figures/error_model/run_holdout_blind_3.sh: never fitted on
+    papanastasiou_couette(3.0, 2), bingham_poiseuille(4.0, 3), newtonian_poiseuille(2, 0.25),
     dst_flow_curve_point(0.54, 2.5),
     dst_flow_curve_point(0.50, 1.0))}
 
