@@ -3,7 +3,7 @@
 Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N] [--tolerance EPS]`` (an SPH
 run, see :mod:`suspsim.run`, or a DST run of a wyart_cates scene, see :mod:`suspsim.dst.run`;
 ``--tolerance`` chooses the numerics from the error model, :mod:`suspsim.convergence.tolerance`),
-``suspsim bench [--scene NAME] [--threads N] [--steps K] [--json]`` and
+``suspsim bench [--scene NAME] [--threads N] [--steps K] [--particles N] [--json]`` and
 ``suspsim pack --shape sphere|sand --phi PHI --radius A --box LX LY LZ --out PACK.nc
 [--polydispersity S] [--seed N] ...`` (a random packing, see :mod:`suspsim.bodies.packing`).
 
@@ -72,6 +72,9 @@ def _build_parser() -> argparse.ArgumentParser:
                        "thread numba may use)")
     bench.add_argument("--steps", type=_positive_int, default=200, help="time steps to time "
                        "(default: 200)")
+    bench.add_argument("--particles", type=_lattice_count, default=32768,
+                       help="lattice sites of the box, a cube k^3 (box side k/1.6 h; default: "
+                       "32768, the 20 h box); for the scaling with N")
     bench.add_argument("--json", action="store_true", help="print one JSON object per scene")
 
     pack = sub.add_parser("pack", help="pack random non-overlapping spheres or sand grains in a "
@@ -113,6 +116,17 @@ _BENCH_COLUMNS = (("scene", "scene", "{}"), ("particles", "n_particles", "{}"),
                   ("density error", "density_error", "{:.2%}"),
                   ("rebuild share", "rebuild_share", "{:.1%}"),
                   ("bytes/particle", "bytes_per_particle", "{:.0f}"))
+
+
+def _lattice_count(text: str) -> int:
+    from .sph.bench import lattice_side
+
+    value = _positive_int(text)
+    try:
+        lattice_side(value)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+    return value
 
 
 def _positive_int(text: str) -> int:
@@ -192,7 +206,7 @@ def _cmd_bench(args) -> int:
         args.threads = numba.config.NUMBA_NUM_THREADS
     results = []
     for name in [args.scene] if args.scene else BENCH_SCENES:
-        result = benchmark(name, args.steps, args.threads)
+        result = benchmark(name, args.steps, args.threads, args.particles)
         if args.json:
             print(json.dumps(result), flush=True)
         results.append(result)

@@ -10,6 +10,7 @@ import pytest
 
 import suspsim.run as run_module
 from suspsim.cli import main
+from suspsim.sph.bench import lattice_side
 from suspsim.io.netcdf import read_run
 from test_run_loop import FakeSimulation, fake
 
@@ -85,22 +86,31 @@ def test_run_exit_codes_with_a_fake_solver(tmp_path, monkeypatch, capsys):
 def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
     calls = []
 
-    def benchmark(scene_name, n_steps, threads):
-        calls.append((scene_name, n_steps, threads))
-        return {"scene": scene_name, "n_particles": 4096, "threads": threads, "steps": n_steps,
-                "wall_time_s": 0.5, "particle_steps_per_s": 4096 * n_steps / 0.5, "rebuilds": 3}
+    def benchmark(scene_name, n_steps, threads, particles):
+        calls.append((scene_name, n_steps, threads, particles))
+        return {"scene": scene_name, "n_particles": particles, "threads": threads,
+                "steps": n_steps, "wall_time_s": 0.5,
+                "particle_steps_per_s": particles * n_steps / 0.5, "rebuilds": 3}
 
     monkeypatch.setitem(sys.modules, "suspsim.sph.bench",
-                        types.SimpleNamespace(benchmark=benchmark))
+                        types.SimpleNamespace(benchmark=benchmark, lattice_side=lattice_side))
     assert main(["-q", "bench", "--steps", "10"]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert len(table) == 5 and "particle-steps/s" in table[0] and "8.19e+04" in table[1]
+    assert len(table) == 5 and "particle-steps/s" in table[0] and "6.55e+05" in table[1]
     assert [c[0] for c in calls] == ["fluid-newtonian", "fluid-papanastasiou",
                                      "suspension-newtonian", "suspension-papanastasiou"]
     assert calls[0][2] == numba.config.NUMBA_NUM_THREADS
     assert main(["-q", "bench", "--scene", "fluid-papanastasiou", "--threads", "1", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert rows == [benchmark("fluid-papanastasiou", 200, 1)]
+    assert rows == [benchmark("fluid-papanastasiou", 200, 1, 32768)]
+    assert main(["-q", "bench", "--scene", "fluid-newtonian", "--particles", "1000000"]) == 0
+    assert calls[-1] == ("fluid-newtonian", 200, numba.config.NUMBA_NUM_THREADS, 1000000)
+    capsys.readouterr()
+    before = len(calls)
+    with pytest.raises(SystemExit) as stop:
+        main(["-q", "bench", "--particles", "30000"])
+    assert stop.value.code == 1 and "cube k^3" in capsys.readouterr().err
+    assert len(calls) == before
 
 
 def test_tiny_real_couette_runs_end_to_end(tmp_path):

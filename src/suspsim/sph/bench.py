@@ -2,7 +2,8 @@
 
 The issue's performance scene: a 3D periodic Lees–Edwards Couette box of side 20 h at number
 density 4.096 per h³ (32³ = 32,768 particles, jittered simple-cubic lattice), Lucy kernel,
-default numerics (bulk correction and dissipation normalisation on). Scenes:
+default numerics (bulk correction and dissipation normalisation on); other sizes k³ in a box
+of side k/1.6 h for the scaling with N (``suspsim bench --particles``). Scenes:
 
 - ``fluid-newtonian``: μ = 1, γ̇ = 0.0244 (particle Reynolds number ρ γ̇ h²/μ = 0.1);
 - ``fluid-papanastasiou``: μ_pl = 0.01, μ_0 = 0.99, M = 100 (seed 000: μ_0/μ_pl = 99), γ̇ = 0.01;
@@ -34,6 +35,8 @@ from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish
 #: Untimed steps before timing: compilation, and the first relaxation of the jittered lattice
 #: (density error ≈ 14 % at step 5, ≈ 1 % from step ~50 on).
 WARM_UP = 50
+#: Lattice sites of the standard box (32³; side 20 h).
+PARTICLES = 32768
 #: Stress samples taken across the timed steps.
 SAMPLES = 20
 #: Scenes of :func:`benchmark` (fluid and shear rate; the box is common).
@@ -49,22 +52,36 @@ SCENES = {
 }
 
 
-def benchmark_scene(scene_name: str):
-    """The validated scene of ``scene_name`` (see :data:`SCENES`)."""
+def lattice_side(particles: int) -> float:
+    """Box side [h] of a k × k × k lattice of ``particles`` = k³ sites at number density 4.096
+    per h³ (lattice spacing 1/1.6 h): k/1.6. Raises ValueError unless ``particles`` is a cube
+    of k ≥ 20 (a box of at least 12.5 h, which holds the suspension scenes' spheres)."""
+    k = round(particles ** (1.0 / 3.0))
+    if k ** 3 != particles or k < 20:
+        raise ValueError(f"particles must be a cube k^3 with k >= 20 (e.g. 8000, 32768, "
+                         f"262144, 1000000), got {particles}")
+    return k / 1.6
+
+
+def benchmark_scene(scene_name: str, particles: int = PARTICLES):
+    """The validated scene of ``scene_name`` (see :data:`SCENES`) in the box of
+    :func:`lattice_side` (``particles`` lattice sites; bodies' shells change the count)."""
     try:
         fluid, rate, inclusions = SCENES[scene_name]
     except KeyError:
         raise ValueError(f"unknown benchmark scene {scene_name!r}; known: "
                          f"{', '.join(SCENES)}") from None
+    side = lattice_side(particles)
     return scene_from_dict({
-        "dimension": 3, "box": [20.0, 20.0, 20.0], "number_density": 4.096, "kernel": "lucy",
+        "dimension": 3, "box": [side, side, side], "number_density": 4.096, "kernel": "lucy",
         "fluid": fluid, "flow": {"type": "couette", "shear_rate": rate},
         "run": {"strain": 1.0, "start": "linear"}, "inclusions": inclusions,
         "lattice": {"jitter": 0.0 if inclusions else 0.1, "relax_max_steps": 100}, "seed": 1})
 
 
-def benchmark(scene_name: str, n_steps: int, threads: int) -> dict:
-    """Time ``n_steps`` full steps of ``scene_name`` on ``threads`` threads.
+def benchmark(scene_name: str, n_steps: int, threads: int, particles: int = PARTICLES) -> dict:
+    """Time ``n_steps`` full steps of ``scene_name`` on ``threads`` threads (box of
+    ``particles`` lattice sites, :func:`benchmark_scene`).
 
     Returns {scene, n_particles, threads, steps, wall_time_s, particle_steps_per_s, rebuilds,
     dt, sound_speed, viscosity_error, density_error, rebuild_share (of the timed wall time),
@@ -76,7 +93,7 @@ def benchmark(scene_name: str, n_steps: int, threads: int) -> dict:
     Sampling is not timed.
     """
     threads = int(min(threads, numba.config.NUMBA_NUM_THREADS))
-    scene = benchmark_scene(scene_name)
+    scene = benchmark_scene(scene_name, particles)
     sim = Simulation(scene, threads=threads)
     sim.advance(WARM_UP)
     builds, rebuild_seconds = sim.rebuild_count, sim.rebuild_seconds
@@ -118,13 +135,13 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     shear_ly = sim._rate * box[1]
     calls = {"density": lambda: (
         summation_density(sim._x, box, sim._offset(sim.time), nl.start, nl.image_start,
-                          nl.neighbours, sim._kernel, SUPPORT, sim._rho, tb.pair_end, tb.pair_j,
-                          tb.pair_geometry, tb.pair_cross, tb.pair_image, sim._scratch_1,
-                          sim._bounds),
+                          nl.neighbours, sim._kernel, SUPPORT, sim._rho, tb.pair_start,
+                          tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
+                          sim._scratch_1, sim._bounds),
         mass_density(sim._rho, sim._mass, sim._volume))}
     if sim._velocity_gradient:
         calls["gradient sums"] = lambda: _gradient_sums(
-            nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
+            tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
             sim._v, sim._volume, shear_ly, sim.scene.dimension, sim._grad_acc, sim._scratch_15,
             sim._bounds)
         calls["gradient finish"] = lambda: _gradient_finish(
@@ -134,13 +151,13 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     if sim._normalise:
         if sim._alpha != 0.0:
             calls["dissipation sums"] = lambda: _dissipation_sums(
-                nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._volume, sim._strain,
+                tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._volume, sim._strain,
                 sim._diss_acc, sim._scratch_1, sim._bounds)
         calls["normalisation finish"] = lambda: _normalisation_finish(
             sim._diss_acc, sim._dissipation, sim._gradient, sim._moment_trace, sim._mu,
             sim._alpha, sim._beta, sim.scene.dimension, sim._factor, sim._mu_hat)
     calls["force sums"] = lambda: force_sums(
-        nl.start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
+        tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
         sim._v, sim._rho, sim._volume, sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2,
         sim._alpha, sim._beta,
         sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of, sim._pressure,

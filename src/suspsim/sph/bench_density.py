@@ -68,7 +68,7 @@ def run_benchmark(skin=0.2, support=1.0, offset=3.3, repeats=20, rounds=3,
     table = allocate_pair_table(n, len(nlist.neighbours))
     density = np.empty(n)
     list_args = (positions, box, offset, nlist.start, nlist.image_start, nlist.neighbours,
-                 kernels.LUCY_3D, support, density, table.pair_end, table.pair_j,
+                 kernels.LUCY_3D, support, density, table.pair_start, table.pair_end, table.pair_j,
                  table.pair_geometry, table.pair_cross, table.pair_image)
     reference = positions.copy()
     scratch = {t: np.empty((t - 1, n)) for t in thread_counts}

@@ -4,7 +4,7 @@ d_p = Σ_q W(r_pq), self term included; ρ_p = m d_p (SPEC §2.2).
 
 The pass also writes the **pair table** of the step, which later passes (shear rate, forces)
 read instead of recomputing geometry: for each listed pair with r < h, in particle i's
-segment ``[start[i], pair_end[i])`` of the list's slots, first the pairs inside the box, from
+segment ``[pair_start[i], pair_end[i])`` of the table, first the pairs inside the box, from
 ``pair_cross[i]`` on those across a face; ``pair_j[k]`` = j, the row ``pair_geometry[k] =
 (dx, dy, dz, F)``: r_ij = r_i − r_j at its nearest image and F(r_ij) of the pass's kernel,
 and for a pair across a face ``pair_image[k]`` = n, its LE image index (velocity correction
@@ -15,6 +15,17 @@ no skin pairs, which are 32 % of the listed pairs at skin 0.2 h); a row per pair
 than an array per column, and n out of the row (int8: |n| ≤ 1 between rebuilds; read for the
 pairs across a face only) saves 0.28 ms per step (``integrator.accelerations`` 9.76 → 9.48
 ms: 32 instead of 40 bytes per pair read by three passes).
+
+The table is **compact**: it holds the pairs within h only, not a row per listed pair. Chunk c
+of the pass (particles lo..hi−1) writes its particles' segments one after the other into its
+own region of the table, rows ⌊P·start[lo]/L⌋ .. ⌊P·start[hi]/L⌋ − 1 (P table rows, L listed
+pairs), so chunks never share rows and the table needs no prefix pass. The pairs within h are
+about (h/r_c)^d of the listed ones (58 % at skin 0.2 h in 3D), so a table sized to them with a
+margin (:func:`pair_capacity`) has 11.2 rows per particle on the benchmark box, where a row
+per list slot took 22.2. A chunk whose region would overflow stops and the pass returns
+:data:`TABLE_OVERFLOW`; the caller grows the table and repeats the pass, which gives the same
+pairs in the same order, so results do not depend on the table's size. With the float32 rows
+(:data:`GEOMETRY_DTYPE`) the table went from 912 to 234 bytes per particle.
 
 Pattern of a pair pass:
 
@@ -37,7 +48,8 @@ Pattern of a pair pass:
   compiled per kernel (a runtime code inside the loop: 6.3 vs 4.5 ns per pair; function
   objects as arguments are as fast but make the caller uncacheable);
 - i's own sum is kept in a register and j's share scattered (half list, each pair once);
-- parallel (``chunks``): particles are split into contiguous chunks of equal pair count;
+- parallel (``chunks``): particles are split into contiguous chunks of equal listed-pair count
+  (this pass computes the bounds; the later passes of the step take them as they are);
   chunk 0 scatters into the output, chunk c ≥ 1 into its own buffer row ``scratch[c − 1]``,
   which ``add_chunk_buffers`` adds afterwards. No races, no allocation,
   and the result depends neither on thread scheduling nor on the thread count, only (at
@@ -72,12 +84,29 @@ from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
 
 #: Columns of ``pair_geometry``.
 DX, DY, DZ, F = range(4)
+#: Storage of ``pair_geometry`` [choice]: float32 halves the table (16 instead of 32 bytes a
+#: row). The passes compute in float64 from the rounded r_ij and F (relative error 2⁻²⁴ ≈ 6e-8),
+#: each pair's row serving both particles, so pair forces stay antisymmetric and momentum is
+#: conserved to float64 round-off. Measured on the benchmark box (fluid-papanastasiou, 350
+#: steps): the viscosity changes by 8e-11 of itself and the density error by 2e-11, and a
+#: linear velocity field's corrected gradient stays exact to 2.5e-7 on a disordered set
+#: (float64: 1e-12); tests hold that to 16 ε of this type.
+GEOMETRY_DTYPE = np.float32
+#: Return codes of :func:`summation_density`.
+TABLE_OK, TABLE_OVERFLOW = 0, 1
+#: Table rows per expected pair within h [choice]: the margin over the ideal-gas count. A
+#: sheared SPH fluid holds more close pairs than an ideal gas (its first neighbour shell lies
+#: inside h): on the benchmark box 1.06 of the ideal count at the start, rising to 1.17 within
+#: 300 steps, so 1.3 leaves 11 % for compressed regions and for a chunk holding more than its
+#: share; beyond that the table grows (``Simulation``) and keeps its size.
+PAIR_MARGIN = 1.3
 
 
 @dataclass
 class PairTable:
-    """The step's pairs within h, in the slots of the neighbour list (see module docstring)."""
+    """The step's pairs within h, compact per chunk (see module docstring)."""
 
+    pair_start: np.ndarray
     pair_end: np.ndarray
     pair_j: np.ndarray
     pair_geometry: np.ndarray
@@ -85,11 +114,22 @@ class PairTable:
     pair_image: np.ndarray
 
 
+def pair_capacity(n_particles: int, number_density: float, support: float, dimension: int,
+                  list_capacity: int) -> int:
+    """Table rows for ``n_particles`` at ``number_density`` [length^−d]: :data:`PAIR_MARGIN` ×
+    the ideal-gas half-list pair count within ``support``, at most ``list_capacity`` (a table
+    with a row per listed pair never overflows)."""
+    ball = math.pi * support ** 2 if dimension == 2 else 4.0 / 3.0 * math.pi * support ** 3
+    rows = int(PAIR_MARGIN * 0.5 * number_density * ball * n_particles) + 64
+    return min(rows, int(list_capacity))
+
+
 def allocate_pair_table(n_particles: int, capacity: int) -> PairTable:
-    """Pair table for a neighbour list of ``capacity`` slots."""
-    return PairTable(pair_end=np.zeros(n_particles, dtype=np.int64),
+    """Pair table of ``capacity`` rows."""
+    return PairTable(pair_start=np.zeros(n_particles, dtype=np.int64),
+                     pair_end=np.zeros(n_particles, dtype=np.int64),
                      pair_j=np.zeros(capacity, dtype=np.uint32),
-                     pair_geometry=np.zeros((capacity, 4)),
+                     pair_geometry=np.zeros((capacity, 4), dtype=GEOMETRY_DTYPE),
                      pair_cross=np.zeros(n_particles, dtype=np.int64),
                      pair_image=np.zeros(capacity, dtype=np.int8))
 
@@ -116,18 +156,27 @@ def _pair(j, s, dx, dy, dz, kernel, h, h2, acc, pair_j, pair_geometry):
 
 @njit(inline="always", **JIT_OPTIONS)
 def _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours, kernel, h,
-                  acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image):
+                  acc, row_lo, row_hi, pair_start, pair_end, pair_j, pair_geometry, pair_cross,
+                  pair_image):
     """acc[p] += Σ_q W(r_pq) over the listed pairs of particles lo..hi−1 (both ends), + W(0);
-    pair table of lo..hi−1."""
+    their pair table segments one after the other in rows row_lo..row_hi−1. Returns
+    :data:`TABLE_OVERFLOW` (and stops, with pair_end[hi − 1] = −1 as the mark that
+    :func:`summation_density` reads) when a particle's listed pairs might not fit."""
     lx, ly, lz = box[0], box[1], box[2]
     h2 = h * h
     w0 = kernel_w(kernel, 0.0, h)
+    row = row_lo
     for i in range(lo, hi):
         xi, yi, zi = positions[i, 0], positions[i, 1], positions[i, 2]
         own = w0
         first, last = start[i], start[i + 1]
+        # _pair writes a row before it knows whether the pair is kept: room for every listed one.
+        if row + (last - first) > row_hi:
+            pair_end[hi - 1] = -1
+            return TABLE_OVERFLOW
         listed = neighbours[first:last]
-        js, rows, images = pair_j[first:last], pair_geometry[first:last], pair_image[first:last]
+        end = row + (last - first)
+        js, rows, images = pair_j[row:end], pair_geometry[row:end], pair_image[row:end]
         n_plain = image_start[i] - first
         s = 0
         for k in range(n_plain):
@@ -135,7 +184,8 @@ def _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours
             w, s = _pair(j, s, xi - positions[j, 0], yi - positions[j, 1], zi - positions[j, 2],
                          kernel, h, h2, acc, js, rows)
             own += w
-        pair_cross[i] = first + s
+        pair_start[i] = row
+        pair_cross[i] = row + s
         crossing = listed[n_plain:]
         for k in range(crossing.shape[0]):
             j = np.uint32(crossing[k])
@@ -144,28 +194,45 @@ def _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours
             images[s] = n
             w, s = _pair(j, s, dx, dy, dz, kernel, h, h2, acc, js, rows)
             own += w
-        pair_end[i] = first + s
+        row += s
+        pair_end[i] = row
         acc[i] += own
+    return TABLE_OK
 
 
 @njit(**JIT_OPTIONS)
 def _density_chunk(lo, hi, positions, box, offset, start, image_start, neighbours, kernel, h,
-                   acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image):
+                   acc, row_lo, row_hi, pair_start, pair_end, pair_j, pair_geometry, pair_cross,
+                   pair_image):
     """:func:`_density_loop` compiled once per kernel code (the code is a constant in each)."""
     if kernel == LUCY_3D:
-        _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours, LUCY_3D,
-                      h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
+        return _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
+                             LUCY_3D, h, acc, row_lo, row_hi, pair_start, pair_end, pair_j,
+                             pair_geometry, pair_cross, pair_image)
     elif kernel == LUCY_2D:
-        _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours, LUCY_2D,
-                      h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
+        return _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
+                             LUCY_2D, h, acc, row_lo, row_hi, pair_start, pair_end, pair_j,
+                             pair_geometry, pair_cross, pair_image)
     elif kernel == QUINTIC_3D:
-        _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
-                      QUINTIC_3D, h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
+        return _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
+                             QUINTIC_3D, h, acc, row_lo, row_hi, pair_start, pair_end, pair_j,
+                             pair_geometry, pair_cross, pair_image)
     elif kernel == QUINTIC_2D:
-        _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
-                      QUINTIC_2D, h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
+        return _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours,
+                             QUINTIC_2D, h, acc, row_lo, row_hi, pair_start, pair_end, pair_j,
+                             pair_geometry, pair_cross, pair_image)
     else:
         raise ValueError(_KERNEL_ERROR)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def _chunk_rows(start, lo, hi, n_rows):
+    """Table rows of the chunk of particles lo..hi−1: its share of the listed pairs, scaled to
+    ``n_rows`` (module docstring)."""
+    n_listed = start[start.shape[0] - 1]
+    if n_listed == 0:
+        return 0, 0
+    return start[lo] * n_rows // n_listed, start[hi] * n_rows // n_listed
 
 
 @njit(parallel=True, **JIT_OPTIONS)
@@ -178,19 +245,22 @@ def mass_density(density, mass, volume):
 
 @njit(**JIT_OPTIONS)
 def summation_density_serial(positions, box, offset, start, image_start, neighbours, kernel, h,
-                             density, pair_end, pair_j, pair_geometry, pair_cross, pair_image):
+                             density, pair_start, pair_end, pair_j, pair_geometry, pair_cross,
+                             pair_image):
     """d_p = Σ_q W(r_pq) incl. self [SPEC §2.2; Martys 2010 Eq. 6] and the pair table, one
-    thread; arguments as :func:`summation_density`."""
+    thread; arguments and return code as :func:`summation_density`."""
     density[:] = 0.0
-    _density_chunk(0, positions.shape[0], positions, box, offset, start, image_start,
-                   neighbours, kernel, h, density, pair_end, pair_j, pair_geometry, pair_cross,
-                   pair_image)
+    n = positions.shape[0]
+    row_lo, row_hi = _chunk_rows(start, 0, n, pair_j.shape[0])
+    return _density_chunk(0, n, positions, box, offset, start, image_start, neighbours, kernel,
+                          h, density, row_lo, row_hi, pair_start, pair_end, pair_j,
+                          pair_geometry, pair_cross, pair_image)
 
 
 @njit(parallel=True, **JIT_OPTIONS)
 def summation_density(positions, box, offset, start, image_start, neighbours, kernel, h,
-                      density, pair_end, pair_j, pair_geometry, pair_cross, pair_image, scratch,
-                      bounds):
+                      density, pair_start, pair_end, pair_j, pair_geometry, pair_cross,
+                      pair_image, scratch, bounds):
     """d_p = Σ_q W(r_pq) incl. self [SPEC §2.2; Martys 2010 Eq. 6] and the pair table, parallel.
 
     Parameters
@@ -201,33 +271,44 @@ def summation_density(positions, box, offset, start, image_start, neighbours, ke
     start, image_start, neighbours : CSR half list from ``build_neighbour_list``
     kernel : int, kernel code (``kernels.LUCY_3D`` ...); h : support radius
     density : (N,) float64, output
-    pair_end, pair_j, pair_geometry, pair_cross, pair_image : output pair table
+    pair_start, pair_end, pair_j, pair_geometry, pair_cross, pair_image : output pair table
         (:func:`allocate_pair_table`)
     scratch : (T − 1, N) float64: the pass runs T chunks (one row per chunk after the
         first); T = ``numba.get_num_threads()`` for full speed, T = 1 (shape (0, N)) serial
     bounds : (T + 1,) int64 scratch for the chunk bounds
+
+    Returns :data:`TABLE_OK`, or :data:`TABLE_OVERFLOW` when the table is too small (density
+    and table are then incomplete: grow the table and call again).
     """
     if kernel != LUCY_3D and kernel != LUCY_2D and kernel != QUINTIC_3D and kernel != QUINTIC_2D:
         raise ValueError(_KERNEL_ERROR)  # here: an exception inside prange is a SystemError
     n_chunks = scratch.shape[0] + 1
+    n_rows = pair_j.shape[0]
     chunk_bounds(start, n_chunks, bounds)
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]
+        row_lo, row_hi = _chunk_rows(start, lo, hi, n_rows)
         if c == 0:
             density[:] = 0.0
             _density_chunk(lo, hi, positions, box, offset, start, image_start, neighbours,
-                           kernel, h, density, pair_end, pair_j, pair_geometry, pair_cross,
-                           pair_image)
+                           kernel, h, density, row_lo, row_hi, pair_start, pair_end, pair_j,
+                           pair_geometry, pair_cross, pair_image)
         else:
             acc = scratch[c - 1]
             acc[lo:] = 0.0
             _density_chunk(lo, hi, positions, box, offset, start, image_start, neighbours,
-                           kernel, h, acc, pair_end, pair_j, pair_geometry, pair_cross, pair_image)
+                           kernel, h, acc, row_lo, row_hi, pair_start, pair_end, pair_j,
+                           pair_geometry, pair_cross, pair_image)
+    # Chunks report through their last particle's pair_end: no allocation in the step.
+    for c in range(n_chunks):
+        if bounds[c + 1] > bounds[c] and pair_end[bounds[c + 1] - 1] < 0:
+            return TABLE_OVERFLOW
     add_chunk_buffers(density, scratch, bounds, n_chunks, 1)
+    return TABLE_OK
 
 
 @njit(**JIT_OPTIONS)
-def body_particle_density(start, pair_end, pair_j, geometry, body_of, kernel, h, rho, rho_eq,
+def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho, rho_eq,
                           c2, mass, weight, weighted, volume):
     """Density of rigid-body particles from the pressure of the fluid around them.
 
@@ -247,7 +328,7 @@ def body_particle_density(start, pair_end, pair_j, geometry, body_of, kernel, h,
     for i in range(n):
         body_i = body_of[i]
         p_i = c2 * (rho[i] - rho_eq)
-        for k in range(start[i], pair_end[i]):
+        for k in range(pair_start[i], pair_end[i]):
             j = pair_j[k]
             body_j = body_of[j]
             if (body_i < 0) == (body_j < 0):

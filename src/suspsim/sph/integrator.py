@@ -10,8 +10,9 @@ One step of size δt:
 The viscosity update uses ṽ (the gradient pass reads ṽ). The imposed Couette flow is
 γ̇ (y − L_y/2) (``lattice``), at rest at y_0 = L_y/2, the origin of the rebuild criterion. :func:`advance_steps` runs whole steps
 in compiled code and returns early, after the drift of a step, when the neighbour list must be
-rebuilt (``neighbours.needs_rebuild``); the caller rebuilds (wrap, sort, list) and calls again
-with ``resume=True``, which finishes that step. Time is step_count · δt (no drift of round-off).
+rebuilt (``neighbours.needs_rebuild``) or, after a density pass that found the pair table too
+small, the table grown; the caller rebuilds (wrap, sort, list) or grows the table and calls
+again with ``resume=True``, which finishes that step. Time is step_count · δt (no drift of round-off).
 
 Symbols: x, v, a positions, velocities, accelerations (N, 3); ṽ predicted velocity; λ the
 Groot–Warren factor; δt time step [τ]; γ̇ imposed shear rate; Δ Lees–Edwards offset.
@@ -22,7 +23,8 @@ from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.boundaries import lees_edwards_offset
-from suspsim.sph.density import body_particle_density, mass_density, summation_density
+from suspsim.sph.density import (TABLE_OK, body_particle_density, mass_density,
+                                 summation_density)
 from suspsim.sph.neighbours import needs_rebuild
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
@@ -31,6 +33,8 @@ from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish
 
 #: Groot–Warren λ [seed 000 Eq. 23].
 LAMBDA = 0.5
+#: Why :func:`advance_steps` returned.
+DONE, REBUILD, GROW_TABLE = 0, 1, 2
 
 
 @njit(parallel=True, **JIT_OPTIONS)
@@ -66,11 +70,14 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, smooth_rate, normalise, alpha, beta,
                   bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
-                  pair_end, pair_j, geometry, pair_cross, pair_image, gradient, inverse_moment,
+                  pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient, inverse_moment,
                   moment_trace, strain, dissipation, gdot, viscosity, factor, viscosity_hat,
                   grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6, bounds, virial,
                   accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
+
+    Returns ``density.TABLE_OK``, or ``density.TABLE_OVERFLOW`` straight after the density pass
+    when the pair table is too small: grow it and call again (nothing else was changed).
 
     ``velocity_gradient`` runs the gradient pass (needed by a non-Newtonian law or the
     normalisation); ``smooth_rate`` evaluates a non-Newtonian law at the kernel-smoothed rate
@@ -82,36 +89,40 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     body (``force_pass``).
     """
     shear_ly = shear_rate * box[1]
-    summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
-                      rho, pair_end, pair_j, geometry, pair_cross, pair_image, scratch_1, bounds)
+    code = summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours,
+                             kernel, h, rho, pair_start, pair_end, pair_j, geometry, pair_cross,
+                             pair_image, scratch_1, bounds)
+    if code != TABLE_OK:
+        return code
     mass_density(rho, mass, volume)
     if has_bodies:
-        body_particle_density(nl_start, pair_end, pair_j, geometry, body_of, kernel, h, rho,
+        body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho,
                               rho_eq, c2, mass, dissipation, diss_acc, volume)
     if velocity_gradient:
-        _gradient_sums(nl_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted,
+        _gradient_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted,
                        volume, shear_ly, dimension, grad_acc, scratch_15, bounds)
         _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian or smooth_rate,
                          normalise, beta, gradient, inverse_moment, moment_trace, gdot,
                          viscosity, strain, dissipation)
         if smooth_rate and not newtonian:
-            smoothed_rate_viscosity(nl_start, pair_end, pair_j, geometry, kernel, h, volume,
+            smoothed_rate_viscosity(pair_start, pair_end, pair_j, geometry, kernel, h, volume,
                                     gradient, body_of, law_code, law_params,
                                     grad_acc[:RATE_WIDTH * rho.shape[0]], scratch_15, bounds,
                                     gdot, viscosity)
     if normalise:
         if alpha != 0.0:
-            _dissipation_sums(nl_start, pair_end, pair_j, geometry, volume, strain, diss_acc,
+            _dissipation_sums(pair_start, pair_end, pair_j, geometry, volume, strain, diss_acc,
                               scratch_1, bounds)
         _normalisation_finish(diss_acc, dissipation, gradient, moment_trace, viscosity, alpha,
                               beta, dimension, factor, viscosity_hat)
     elif not newtonian:
         viscosity_hat[:] = viscosity
-    force_sums(nl_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
+    force_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
                volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
                shear_ly, body_of, pressure, force_acc, scratch_6, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
+    return TABLE_OK
 
 
 @njit(**JIT_OPTIONS)
@@ -120,14 +131,15 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies,
-                  body_of, rho, volume, pressure, pair_end, pair_j, geometry, pair_cross,
+                  body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
                   pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
                   viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
                   scratch_15, scratch_6, bounds, virial):
-    """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, rebuild?).
+    """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, stop).
 
-    With rebuild? true the drift of step ``step_count + completed + 1`` has been applied and
-    the list must be rebuilt before calling again with ``resume=True`` (module docstring).
+    stop is :data:`DONE`, or :data:`REBUILD` or :data:`GROW_TABLE`: the drift of step
+    ``step_count + completed + 1`` has been applied and the list must be rebuilt, or the pair
+    table grown (``density``), before calling again with ``resume=True`` (module docstring).
     """
     done = 0
     while done < n_steps:
@@ -136,18 +148,21 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
             drift(positions, velocities, accel, dt)
             if needs_rebuild(positions, reference, shear_rate * (time - build_time), cutoff,
                              skin, 0.5 * box[1]):
-                return done, True
+                return done, REBUILD
         resume = False
         offset = lees_edwards_offset(shear_rate, box[0], box[1], time)
         predict(velocities, accel, dt, predicted)
-        accelerations(positions, predicted, box, offset, nl_start, nl_image_start,
+        code = accelerations(positions, predicted, box, offset, nl_start, nl_image_start,
                       nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate, body_force,
                       dimension, law_code, law_params, newtonian, velocity_gradient, smooth_rate,
                       normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
-                      volume, pressure, pair_end, pair_j, geometry, pair_cross, pair_image,
+                      volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
+                      pair_image,
                       gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
                       factor, viscosity_hat, grad_acc, diss_acc,
                       force_acc, scratch_1, scratch_15, scratch_6, bounds, virial, accel_new)
+        if code != TABLE_OK:
+            return done, GROW_TABLE
         kick(velocities, accel, accel_new, dt)
         done += 1
-    return done, False
+    return done, DONE

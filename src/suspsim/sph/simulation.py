@@ -38,8 +38,9 @@ from suspsim.rheology.laws import make_law
 from suspsim.scene import Scene
 from suspsim.sph import kernels
 from suspsim.sph.boundaries import lees_edwards_offset
-from suspsim.sph.density import allocate_pair_table
-from suspsim.sph.integrator import accelerations, advance_steps, drift, kick, predict
+from suspsim.sph.density import TABLE_OK, allocate_pair_table, pair_capacity
+from suspsim.sph.integrator import (GROW_TABLE, REBUILD, accelerations, advance_steps, drift,
+                                    kick, predict)
 from suspsim.sph.lattice import imposed_velocity, initial_velocities, lattice_positions
 from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbour_list,
                                     build_neighbour_list, needs_rebuild, raise_for_code,
@@ -58,6 +59,9 @@ log = logging.getLogger(__name__)
 SKIN = 0.2
 #: Support radius in scene units.
 SUPPORT = 1.0
+#: Neighbour-list slots per ideal-gas pair within h + skin [choice]: a fluid lists 0.91 of them
+#: (benchmark box), so 1.2 leaves 30 %; an overflow grows the list and repeats the build.
+LIST_CAPACITY = 1.2
 #: Velocity damping per relaxation step [1] and steps between its density checks [choice].
 RELAX_DAMPING = 0.05
 RELAX_CHECK = 10
@@ -147,7 +151,7 @@ class Simulation:
             self._build_time = float(_state["build_time"])
         self.rebuild_count = 0
         self.rebuild_seconds = 0.0
-        self._allocate(positions, velocities, capacity_factor=1.5)
+        self._allocate(positions, velocities, capacity_factor=LIST_CAPACITY)
         if _state is None and self.bodies is not None:
             self._body_of[:] = setup.body_of
             self._offsets[:] = setup.offsets
@@ -163,7 +167,9 @@ class Simulation:
                 self.bodies.set_forces(*self._body_forces(self.bodies.rotations()))
         else:
             for name, attribute in _STATE_ARRAYS.items():
-                getattr(self, attribute)[...] = _state[name]
+                target = getattr(self, attribute)
+                if target.size:  # body offsets of a run without bodies: empty
+                    target[...] = _state[name]
             if self.bodies is not None:
                 self._body_virial[:] = _state["body_virial"]
                 self._lubrication_virial[:] = _state["lubrication_virial"]
@@ -183,7 +189,6 @@ class Simulation:
         self._v_pred = np.zeros((n, 3))
         self._rho = np.zeros(n)
         self._volume = np.zeros(n)
-        self._pressure = np.zeros(n)
         self._strain = np.zeros((n, 6))
         self._dissipation = np.zeros(n)
         self._gdot = np.zeros(n)
@@ -194,33 +199,55 @@ class Simulation:
         self._gradient = np.zeros((n, 9))
         self._inverse_moment = np.zeros((n, 6))
         self._moment_trace = np.zeros(n)
+        # The passes' accumulators and chunk buffers live one pass each (density → gradient →
+        # smoothing → dissipation → force → body forces → shifting, one after the other), so
+        # the narrower ones, and the force pass's pressure scratch, are views of the 15-wide
+        # ones: 176 bytes per particle and chunk fewer. The force sums stay readable until the
+        # next step (bodies read them).
         self._grad_acc = np.zeros(n * GRADIENT_WIDTH)
-        self._diss_acc = np.zeros(n)
-        self._force_acc = np.zeros(n * FORCE_WIDTH)
-        self._scratch_1 = np.zeros((t - 1, n))
+        self._force_acc = self._grad_acc[:n * FORCE_WIDTH]
+        self._diss_acc = self._grad_acc[(GRADIENT_WIDTH - 1) * n:]
+        self._pressure = self._grad_acc[FORCE_WIDTH * n:(FORCE_WIDTH + 1) * n]
         self._scratch_15 = np.zeros((t - 1, n * GRADIENT_WIDTH))
-        self._scratch_6 = np.zeros((t - 1, n * FORCE_WIDTH))
+        self._scratch_6 = self._scratch_15.reshape(-1)[:(t - 1) * n * FORCE_WIDTH].reshape(
+            t - 1, n * FORCE_WIDTH)
+        self._scratch_1 = self._scratch_15.reshape(-1)[:(t - 1) * n].reshape(t - 1, n)
         self._bounds = np.zeros(t + 1, dtype=np.int64)
         self._virial = np.zeros((t, 5))
         self._body_of = np.full(n, -1, dtype=np.int64)
-        self._offsets = np.zeros((n, 3))
+        self._offsets = np.zeros((n if self.bodies is not None else 0, 3))
         self._members = np.zeros(0, dtype=np.int64)
         self._grad_c = np.zeros(3 * n if self._shifting > 0.0 else 0)
         self._body_virial = np.zeros(5)
         self._lubrication_virial = np.zeros(5)
         self._lubrication_stats = np.array([np.inf, 0.0, 0.0])
         self._allocate_list(capacity_factor)
+        self._table = allocate_pair_table(n, pair_capacity(
+            n, self.scene.number_density, SUPPORT, self.scene.dimension,
+            self._nlist.neighbours.shape[0]))
 
     def _allocate_list(self, capacity_factor: float) -> None:
         self._nlist = allocate_neighbour_list(self.n_particles, self._box, SUPPORT, SKIN,
                                               self.scene.dimension, self.scene.number_density,
                                               capacity_factor=capacity_factor)
         self._reference = self._nlist.reference
-        self._table = allocate_pair_table(self.n_particles, self._nlist.neighbours.shape[0])
         self._capacity_factor = capacity_factor
+
+    def _grow_table(self) -> None:
+        """A pair table 1.15 × larger (at most a row per listed pair, which cannot overflow)."""
+        rows = min(int(1.15 * self._table.pair_j.shape[0]) + 64,
+                   int(self._nlist.neighbours.shape[0]))
+        log.info("pair table overflow; %d rows (%.1f per particle)", rows,
+                 rows / self.n_particles)
+        self._table = allocate_pair_table(self.n_particles, rows)
 
     def _offset(self, time: float) -> float:
         return float(lees_edwards_offset(self._rate, self._box[0], self._box[1], time))
+
+    def _permuted_arrays(self) -> tuple:
+        """Particle arrays a rebuild reorders besides x and v (body offsets only with bodies:
+        without them ``_offsets`` is empty)."""
+        return (self._a, self._body_of) + ((self._offsets,) if self.bodies is not None else ())
 
     def _rebuild(self, time: float) -> None:
         """Wrap, sort and list at ``time``; grows the list once per overflow."""
@@ -229,7 +256,7 @@ class Simulation:
             try:
                 rebuild_neighbour_list(self._nlist, self._x, self._v, self._box,
                                        self._offset(time), self._rate,
-                                       particle_arrays=(self._a, self._body_of, self._offsets))
+                                       particle_arrays=self._permuted_arrays())
                 break
             except NeighbourListOverflowError as err:
                 factor = 1.3 * err.required / err.capacity * self._capacity_factor
@@ -263,17 +290,23 @@ class Simulation:
                 self._beta, self._bulk_factor, self._bulk_gradient, self.bodies is not None,
                 self._body_of,
                 self._rho, self._volume,
-                self._pressure, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross,
+                self._pressure, tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross,
                 tb.pair_image, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
                 self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
                 self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,
                 self._scratch_6, self._bounds, self._virial)
 
-    def _compute_accelerations(self, predicted, out) -> None:
+    def _compute_accelerations(self, predicted, out, time: float | None = None) -> None:
+        """a = f(x, ``predicted``)/m into ``out`` at ``time`` (default: now), growing the pair
+        table until it holds the step's pairs."""
         use_threads(self.threads)
-        box, *rest = self._physics_args()
-        accelerations(self._x, predicted, box, self._offset(self.time), *rest, out)
+        offset = self._offset(self.time if time is None else time)
+        while True:
+            box, *rest = self._physics_args()
+            if accelerations(self._x, predicted, box, offset, *rest, out) == TABLE_OK:
+                return
+            self._grow_table()
 
     # ------------------------------------------------------------------ API
     @property
@@ -296,16 +329,18 @@ class Simulation:
         nl = self._nlist
         while remaining > 0:
             box, *physics = self._physics_args()
-            done, rebuild = advance_steps(
+            done, stop = advance_steps(
                 remaining, resume, self.step_count, self.dt, self._build_time, nl.cutoff,
                 nl.skin, self._reference, self._x, self._v, self._a, self._v_pred, self._a_new,
                 box, *physics)
             self.step_count += int(done)
             remaining -= int(done)
-            resume = bool(rebuild)
-            if rebuild:
+            resume = stop in (REBUILD, GROW_TABLE)
+            if stop == REBUILD:
                 self._rebuild((self.step_count + 1) * self.dt)
                 nl = self._nlist
+            elif stop == GROW_TABLE:
+                self._grow_table()
 
     @property
     def n_body_particles(self) -> int:
@@ -396,8 +431,7 @@ class Simulation:
             predict(self._v, self._a, dt, self._v_pred)
             if bodies is not None:
                 self._place_bodies(rotations, *predicted, time, self._v_pred)
-            box, *rest = self._physics_args()
-            accelerations(self._x, self._v_pred, box, self._offset(time), *rest, self._a_new)
+            self._compute_accelerations(self._v_pred, self._a_new, time)
             kick(self._v, self._a, self._a_new, dt)
             if bodies is not None:
                 bodies.kick(*self._body_forces(rotations), dt)
@@ -407,7 +441,7 @@ class Simulation:
                                    time, self._v)
             if self._shifting > 0.0:
                 tb = self._table
-                shift_particles(self._nlist.start, tb.pair_end, tb.pair_j, tb.pair_geometry,
+                shift_particles(tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry,
                                 self._volume, self._body_of, self._shifting,
                                 self._shifting_rate, dt, SUPPORT, self._gradient, self._grad_c, self._scratch_15,
                                 self._bounds, self._x, self._v)
@@ -504,7 +538,8 @@ class Simulation:
         for group in (self._nlist, self._table):
             held += [getattr(group, f.name) for f in dataclasses.fields(group)
                      if isinstance(getattr(group, f.name), np.ndarray)]
-        return sum({id(a): a.nbytes for a in held}.values())
+        owners = [a if a.base is None else a.base for a in held]  # a view counts as its buffer
+        return sum({id(a): a.nbytes for a in owners}.values())
 
     def _peculiar(self) -> np.ndarray:
         """Velocities relative to the imposed flow (positions unwrapped since the last build)."""

@@ -8,7 +8,8 @@ import pytest
 
 from suspsim.sph import kernels as K
 from suspsim.sph import neighbours as nb
-from suspsim.sph.density import (DX, DZ, F, allocate_pair_table, summation_density,
+from suspsim.sph.density import (DX, DZ, F, GEOMETRY_DTYPE, TABLE_OK, TABLE_OVERFLOW,
+                                 allocate_pair_table, summation_density,
                                  summation_density_serial)
 
 CUTOFF = 1.0
@@ -232,14 +233,14 @@ def test_box_too_small():
 
 # ------------------------------------------------------------------------------ density
 
-def density_pass(positions, box, offset, nlist, kernel, h, n_chunks=2, table=None):
+def density_pass(positions, box, offset, nlist, kernel, h, n_chunks=2, table=None, code=TABLE_OK):
     density = np.empty(len(positions))
     table = table or allocate_pair_table(len(positions), len(nlist.neighbours))
     scratch = np.empty((n_chunks - 1, len(positions)))
     bounds = np.empty(n_chunks + 1, dtype=np.int64)
-    summation_density(positions, box, offset, nlist.start, nlist.image_start, nlist.neighbours,
-                      kernel, h, density, table.pair_end, table.pair_j, table.pair_geometry,
-                      table.pair_cross, table.pair_image, scratch, bounds)
+    assert code == summation_density(positions, box, offset, nlist.start, nlist.image_start, nlist.neighbours,
+                      kernel, h, density, table.pair_start, table.pair_end, table.pair_j,
+                      table.pair_geometry, table.pair_cross, table.pair_image, scratch, bounds)
     return density
 
 
@@ -257,7 +258,8 @@ def test_density_equals_brute_force(dim, kernel, offset):
     serial = np.empty(len(moved))
     table = allocate_pair_table(len(moved), len(nlist.neighbours))
     summation_density_serial(moved, box, offset, nlist.start, nlist.image_start,
-                             nlist.neighbours, kernel, h, serial, table.pair_end, table.pair_j,
+                             nlist.neighbours, kernel, h, serial, table.pair_start,
+                             table.pair_end, table.pair_j,
                              table.pair_geometry, table.pair_cross, table.pair_image)
     np.testing.assert_allclose(serial, expected, rtol=1e-12)
     np.testing.assert_array_equal(density_pass(moved, box, offset, nlist, kernel, h, 1), serial)
@@ -266,13 +268,15 @@ def test_density_equals_brute_force(dim, kernel, offset):
         np.testing.assert_allclose(
             density_pass(moved, box, offset, nlist, kernel, h, chunks, parallel_table),
             serial, rtol=1e-14)
-        np.testing.assert_array_equal(parallel_table.pair_end, table.pair_end)
-        np.testing.assert_array_equal(parallel_table.pair_cross, table.pair_cross)
+        np.testing.assert_array_equal(parallel_table.pair_end - parallel_table.pair_start,
+                                      table.pair_end - table.pair_start)
+        np.testing.assert_array_equal(parallel_table.pair_cross - parallel_table.pair_start,
+                                      table.pair_cross - table.pair_start)
     # pair table: exactly the pairs within h, with nearest-image vector, F and image index (in
     # pair_image from pair_cross on, the pairs across a face; the others are inside the box)
-    counts = table.pair_end - nlist.start[:-1]
+    counts = table.pair_end - table.pair_start
     i = np.repeat(np.arange(len(moved)), counts)
-    k = np.concatenate([np.arange(a, b) for a, b in zip(nlist.start[:-1], table.pair_end)])
+    k = np.concatenate([np.arange(a, b) for a, b in zip(table.pair_start, table.pair_end)])
     j = table.pair_j[k].astype(np.int64)
     assert set(zip(i.tolist(), j.tolist())) == {
         (min(a, b), max(a, b)) for a, b in zip(*np.nonzero(np.triu(r < h, 1)))}
@@ -283,10 +287,46 @@ def test_density_equals_brute_force(dim, kernel, offset):
         n = np.rint(d[1] / box[1])
         shift = [n * offset + box[0] * np.rint((d[0] - n * offset) / box[0]), n * box[1],
                  box[2] * np.rint(d[2] / box[2]) if dim == 3 else 0.0]
-        np.testing.assert_allclose(row[DX:DZ + 1], d - shift, atol=1e-12)
+        np.testing.assert_allclose(row[DX:DZ + 1], d - shift,
+                                   rtol=np.finfo(GEOMETRY_DTYPE).eps, atol=1e-12)
         assert (image if across else 0) == n
         assert across or not np.any(shift)
         assert row[F] == pytest.approx(K.kernel_f(kernel, np.linalg.norm(d - shift), h))
+
+
+@pytest.mark.parametrize("n_chunks", [1, 2, 3])
+def test_compact_table_overflows_cleanly_and_its_size_changes_nothing(n_chunks):
+    """A table too small for the pairs within h reports TABLE_OVERFLOW without writing past any
+    chunk's rows; a compact table, with fewer rows than listed pairs,
+    gives the density and every pair's row bit for bit as a table with a row per listed pair."""
+    rng = np.random.default_rng(4)
+    box, positions = scene("random", BOXES[3][0], 3, rng)
+    h = 0.7
+    nlist, _ = build(positions, box, 3, 0.37, skin=0.3, support=h)
+    full = allocate_pair_table(len(positions), len(nlist.neighbours))
+    expected = density_pass(positions, box, 0.37, nlist, K.LUCY_3D, h, n_chunks, full)
+    within = int(np.sum(full.pair_end - full.pair_start))
+    rows = 2 * within  # room for each chunk's share; still fewer rows than listed pairs
+    assert rows < nlist.start[-1]
+    # a small table whose arrays are the head of larger ones: nothing may land in the tails
+    small, guarded = allocate_pair_table(len(positions), within // 2), within // 2
+    j_tail, geometry_tail = np.full(guarded + 100, 7, np.uint32), np.full((guarded + 100, 4), 7.0)
+    small.pair_j, small.pair_geometry = j_tail[:guarded], geometry_tail[:guarded]
+    density_pass(positions, box, 0.37, nlist, K.LUCY_3D, h, n_chunks, small, TABLE_OVERFLOW)
+    assert np.all(j_tail[guarded:] == 7) and np.all(geometry_tail[guarded:] == 7.0)
+    compact = allocate_pair_table(len(positions), rows)
+    np.testing.assert_array_equal(
+        density_pass(positions, box, 0.37, nlist, K.LUCY_3D, h, n_chunks, compact), expected)
+    np.testing.assert_array_equal(full.pair_end - full.pair_start,
+                                  compact.pair_end - compact.pair_start)
+    np.testing.assert_array_equal(full.pair_cross - full.pair_start,
+                                  compact.pair_cross - compact.pair_start)
+    rows_full = np.concatenate([np.arange(p, q) for p, q in zip(full.pair_start, full.pair_end)])
+    rows_compact = np.concatenate([np.arange(p, q)
+                                   for p, q in zip(compact.pair_start, compact.pair_end)])
+    for name in ("pair_j", "pair_geometry", "pair_image"):
+        np.testing.assert_array_equal(getattr(full, name)[rows_full],
+                                      getattr(compact, name)[rows_compact])
 
 
 @pytest.mark.parametrize("dim,number_density", [(3, 4.096), (2, 4.0)])

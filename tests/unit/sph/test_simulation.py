@@ -65,6 +65,28 @@ def test_resume_from_state_is_bit_for_bit():
     assert resumed.sample() == reference.sample()
 
 
+@pytest.mark.parametrize("shifting", [0.0, 30.0])
+def test_a_pair_table_that_starts_too_small_grows_and_changes_nothing(monkeypatch, shifting):
+    """The compact pair table (``density``) overflows, grows and repeats the density pass, in
+    the compiled step loop and in the Python one (shifting on): positions and velocities equal
+    those of a run whose table never overflowed, bit for bit."""
+    import suspsim.sph.simulation as simulation
+
+    scene = scene_from_dict({
+        "dimension": 3, "box": [5.0] * 3, "number_density": 4.096,
+        "fluid": {"law": "papanastasiou", "params": PAPANASTASIOU},
+        "flow": {"type": "couette", "shear_rate": 0.1}, "run": {"strain": 1.0, "start": "rest"},
+        "lattice": {"jitter": 0.02}, "numerics": {"shifting": shifting}})
+    reference = Simulation(scene, threads=2)
+    monkeypatch.setattr(simulation, "pair_capacity", lambda *args: 100)
+    grown = Simulation(scene, threads=2)
+    assert grown._table.pair_j.shape[0] > 100
+    reference.advance(30)
+    grown.advance(30)
+    np.testing.assert_array_equal(grown._x, reference._x)
+    np.testing.assert_array_equal(grown._v, reference._v)
+
+
 def viscous_limited(coefficient):
     """μ = 100 at ρ = 4.096: the viscous limit (not the acoustic one) binds."""
     return Simulation(couette_scene(params={"mu": 100.0}, rate=0.005,

@@ -53,7 +53,7 @@ def _two_particle_force(body_of, viscosity):
                np.array([1, 1]), np.zeros(1, dtype=np.int64), velocity, np.full(2, 4.0),
                np.full(2, 0.25), np.asarray(viscosity, dtype=float), 1.0, 4.0, 0.0, alpha,
                beta, -5.0 / 3.0, False, 0.0, np.asarray(body_of), np.zeros(2), acc,
-               np.zeros((0, 2 * FORCE_WIDTH)), np.zeros(2, dtype=np.int64), np.zeros((1, 5)))
+               np.zeros((0, 2 * FORCE_WIDTH)), np.array([0, 2]), np.zeros((1, 5)))
     return acc[:3]
 
 

@@ -33,7 +33,7 @@ import math
 from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
-from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
+from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.terms.pressure import pressure_pair, pressure_term
 from suspsim.sph.terms.viscous import explicit_bulk_term, pair_viscosity, viscous_pair
 
@@ -130,7 +130,6 @@ def force_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, veloci
     for i in prange(rho.shape[0]):
         pressure[i] = pressure_term(rho[i], rho_eq, c2, mass)
     n_chunks = scratch.shape[0] + 1
-    chunk_bounds(start, n_chunks, bounds)
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:

@@ -33,7 +33,7 @@ from numba import njit, prange
 
 from suspsim.rheology.laws import viscosity_kernel
 from suspsim.sph import JIT_OPTIONS
-from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
+from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.kernels import kernel_w
 
 #: Values per particle: Σ V W S (6 components, module docstring) and Σ V W.
@@ -84,7 +84,6 @@ def _smoothing_sums(start, pair_end, pair_j, geometry, kernel, h, volume, gradie
     """acc (7 N,) = the sums of every particle in T = scratch.shape[0] + 1 chunks (pattern of
     ``density``; ``scratch`` rows of at least 7 N entries)."""
     n_chunks = scratch.shape[0] + 1
-    chunk_bounds(start, n_chunks, bounds)
     width = acc.shape[0]
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]

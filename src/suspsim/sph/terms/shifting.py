@@ -40,7 +40,7 @@ import math
 from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
-from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
+from suspsim.sph.chunks import add_chunk_buffers
 
 #: Largest shift per step [h] (SPEC §5.5: 0.1 h).
 MAX_SHIFT = 0.1
@@ -77,7 +77,6 @@ def concentration_gradient(start, pair_end, pair_j, geometry, volume, acc, scrat
     """acc (3N,) = ∇C of every particle over the half pair table, in T = scratch.shape[0] + 1
     chunks (the pattern of ``density``; ``scratch`` rows of at least 3N entries)."""
     n_chunks = scratch.shape[0] + 1
-    chunk_bounds(start, n_chunks, bounds)
     n3 = acc.shape[0]
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]

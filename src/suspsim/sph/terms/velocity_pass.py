@@ -23,7 +23,7 @@ from numba import njit, prange
 
 from suspsim.rheology.laws import viscosity_kernel
 from suspsim.sph import JIT_OPTIONS
-from suspsim.sph.chunks import add_chunk_buffers, chunk_bounds
+from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.terms.gradient import XX, YY, ZZ, corrected_gradient, invert_symmetric, shear_rate
 from suspsim.sph.terms.normalisation import (continuum_dissipation, moment_dissipation,
                                              normalisation_factor, quadratic_form, strain_form)
@@ -178,7 +178,6 @@ def _gradient_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, ve
                    shear_ly, dimension, acc, scratch, bounds):
     """acc (15 N,) = (G, M2) of every particle, T = scratch.shape[0] + 1 chunks."""
     n_chunks = scratch.shape[0] + 1
-    chunk_bounds(start, n_chunks, bounds)
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:
@@ -272,7 +271,6 @@ def _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, volume, strain,
 def _dissipation_sums(start, pair_end, pair_j, geometry, volume, strain, acc, scratch, bounds):
     """acc (N,) = Σ_j V_j F (r·S_i r)²/r², the α part of D_i without α (``normalisation``)."""
     n_chunks = scratch.shape[0] + 1
-    chunk_bounds(start, n_chunks, bounds)
     for c in prange(n_chunks):
         lo, hi = bounds[c], bounds[c + 1]
         if c == 0:
