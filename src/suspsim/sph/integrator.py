@@ -12,7 +12,8 @@ The viscosity update uses ṽ (the gradient pass reads ṽ). The imposed Couette
 in compiled code and returns early, after the drift of a step, when the neighbour list must be
 rebuilt (``neighbours.needs_rebuild``) or, after a density pass that found the pair table too
 small, the table grown; the caller rebuilds (wrap, sort, list) or grows the table and calls
-again with ``resume=True``, which finishes that step. Time is step_count · δt (no drift of round-off).
+again with ``resume=True``, which finishes that step. Time is step_count · δt (no drift of
+round-off).
 
 Symbols: x, v, a positions, velocities, accelerations (N, 3); ṽ predicted velocity; λ the
 Groot–Warren factor; δt time step [τ]; γ̇ imposed shear rate; Δ Lees–Edwards offset.
@@ -70,8 +71,9 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, smooth_rate, normalise, alpha, beta,
                   bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
-                  pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient, inverse_moment,
-                  moment_trace, strain, dissipation, gdot, viscosity, factor, viscosity_hat,
+                  pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
+                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
+                  viscosity_hat,
                   grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6, bounds, virial,
                   accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
@@ -131,8 +133,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies,
-                  body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
-                  pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
+                  body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
+                  pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
                   viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
                   scratch_15, scratch_6, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, stop).
@@ -152,15 +154,14 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
         resume = False
         offset = lees_edwards_offset(shear_rate, box[0], box[1], time)
         predict(velocities, accel, dt, predicted)
-        code = accelerations(positions, predicted, box, offset, nl_start, nl_image_start,
-                      nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate, body_force,
-                      dimension, law_code, law_params, newtonian, velocity_gradient, smooth_rate,
-                      normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, rho,
-                      volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
-                      pair_image,
-                      gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
-                      factor, viscosity_hat, grad_acc, diss_acc,
-                      force_acc, scratch_1, scratch_15, scratch_6, bounds, virial, accel_new)
+        code = accelerations(
+            positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
+            mass, rho_eq, c2, shear_rate, body_force, dimension, law_code, law_params, newtonian,
+            velocity_gradient, smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient,
+            has_bodies, body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
+            pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation,
+            gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
+            scratch_15, scratch_6, bounds, virial, accel_new)
         if code != TABLE_OK:
             return done, GROW_TABLE
         kick(velocities, accel, accel_new, dt)

@@ -233,7 +233,8 @@ def test_box_too_small():
 
 # ------------------------------------------------------------------------------ density
 
-def density_pass(positions, box, offset, nlist, kernel, h, n_chunks=2, table=None, code=TABLE_OK):
+def density_pass(positions, box, offset, nlist, kernel, h, n_chunks=2, table=None,
+                 code=TABLE_OK):
     density = np.empty(len(positions))
     table = table or allocate_pair_table(len(positions), len(nlist.neighbours))
     scratch = np.empty((n_chunks - 1, len(positions)))
