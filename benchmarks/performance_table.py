@@ -27,7 +27,7 @@ import sys
 from pathlib import Path
 
 SCENES = ("fluid-newtonian", "fluid-papanastasiou", "suspension-newtonian",
-          "suspension-papanastasiou")
+          "suspension-papanastasiou", "dst-2d")
 SUSPSIM = Path(sys.executable).with_name("suspsim")
 
 

@@ -74,7 +74,8 @@ def _build_parser() -> argparse.ArgumentParser:
                        "(default: 200)")
     bench.add_argument("--particles", type=_lattice_count, default=32768,
                        help="lattice sites of the box, a cube k^3 (box side k/1.6 h; default: "
-                       "32768, the 20 h box); for the scaling with N")
+                       "32768, the 20 h box; dst-2d: about this many fluid particles); for "
+                       "the scaling with N")
     bench.add_argument("--json", action="store_true", help="print one JSON object per scene")
 
     pack = sub.add_parser("pack", help="pack random non-overlapping spheres or sand grains in a "
@@ -106,7 +107,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
 #: Scenes of ``suspsim bench`` (defined in :mod:`suspsim.sph.bench`).
 BENCH_SCENES = ("fluid-newtonian", "fluid-papanastasiou", "suspension-newtonian",
-                "suspension-papanastasiou")
+                "suspension-papanastasiou", "dst-2d")
 _BENCH_COLUMNS = (("scene", "scene", "{}"), ("particles", "n_particles", "{}"),
                   ("threads", "threads", "{}"), ("steps", "steps", "{}"),
                   ("wall s", "wall_time_s", "{:.3g}"),

@@ -96,9 +96,9 @@ def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
                         types.SimpleNamespace(benchmark=benchmark, lattice_side=lattice_side))
     assert main(["-q", "bench", "--steps", "10"]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert len(table) == 5 and "particle-steps/s" in table[0] and "6.55e+05" in table[1]
+    assert len(table) == 6 and "particle-steps/s" in table[0] and "6.55e+05" in table[1]
     assert [c[0] for c in calls] == ["fluid-newtonian", "fluid-papanastasiou",
-                                     "suspension-newtonian", "suspension-papanastasiou"]
+                                     "suspension-newtonian", "suspension-papanastasiou", "dst-2d"]
     assert calls[0][2] == numba.config.NUMBA_NUM_THREADS
     assert main(["-q", "bench", "--scene", "fluid-papanastasiou", "--threads", "1", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
@@ -111,6 +111,18 @@ def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
         main(["-q", "bench", "--particles", "30000"])
     assert stop.value.code == 1 and "cube k^3" in capsys.readouterr().err
     assert len(calls) == before
+
+
+def test_bench_dst_scene_json(tmp_path):
+    """The 2D DST solver's bench scene: about --particles fluid particles plus walls, its
+    speed and memory."""
+    proc = suspsim("bench", "--scene", "dst-2d", "--steps", 3, "--threads", 1, "--particles",
+                   8000, "--json", cwd=tmp_path, timeout=900)
+    assert proc.returncode == 0, proc.stderr
+    row = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert row["scene"] == "dst-2d" and row["steps"] == 3
+    assert row["n_particles"] == 160 * 50 + 2 * 4 * 160  # fluid and two 4-layer walls
+    assert row["particle_steps_per_s"] > 0 and 100 < row["bytes_per_particle"] < 5000
 
 
 def test_tiny_real_couette_runs_end_to_end(tmp_path):

@@ -11,7 +11,9 @@ of side k/1.6 h for the scaling with N (``suspsim bench --particles``). Scenes:
   bodies' shell particles count as particles; the start's relaxation is cut to 100 steps, a
   benchmark measures cost, not physics);
 - ``suspension-papanastasiou``: the Papanastasiou fluid with the same spheres (adds the
-  shear-rate pass and its smoothing, ``terms.rate_smoothing``).
+  shear-rate pass and its smoothing, ``terms.rate_smoothing``);
+- ``dst-2d``: the 2D Wyart–Cates solver between walls (:mod:`suspsim.dst.bench`; a different
+  solver, which reports speed and memory only).
 
 :func:`benchmark` times ``n_steps`` steps after :data:`WARM_UP` untimed steps and
 reports particle-steps per second (N × steps / wall time), neighbour-list rebuilds included,
@@ -24,6 +26,8 @@ import time
 import numba
 import numpy as np
 
+from suspsim.dst.bench import SCENE as DST_SCENE
+from suspsim.dst.bench import benchmark_dst
 from suspsim.scene import scene_from_dict
 from suspsim.sph.density import mass_density, summation_density
 from suspsim.sph.simulation import SUPPORT, Simulation
@@ -93,6 +97,8 @@ def benchmark(scene_name: str, n_steps: int, threads: int, particles: int = PART
     Sampling is not timed.
     """
     threads = int(min(threads, numba.config.NUMBA_NUM_THREADS))
+    if scene_name == DST_SCENE:
+        return benchmark_dst(n_steps, threads, particles, WARM_UP)
     scene = benchmark_scene(scene_name, particles)
     sim = Simulation(scene, threads=threads)
     sim.advance(WARM_UP)
