@@ -1,6 +1,7 @@
 """Sand grains against spheres at equal φ over several packings, in a Newtonian matrix.
 
     python docs/figures/make_shape_seeds.py [--phi 0.3] [--seeds 1 2 3] [--strain 1 4]
+        [--box 16.875] [--shapes sphere sand] [--set KEY=VALUE ...]
 
 The sand and spheres studies compare one packing per φ, in different boxes (15 h and 16.875 h)
 and a thinning matrix. This isolates the shape: both shapes in the same 16.875 h box (the sand
@@ -8,13 +9,21 @@ study's, which holds a grain's reach of 1.63 a), the same volume-equivalent radi
 the Newtonian matrix of :mod:`suspsim.validation.suspension`, and packing seeds 1, 2, 3 for
 each. η_r = σ_xy/(μγ̇) is averaged over whole strain units after the transient; the spread of
 the packings' η_r gives the error of their mean, and sand/spheres is the ratio of the means
-(errors in quadrature). One thread per run; prints a Markdown table and writes nothing else.
+(errors in quadrature). Each run's health is reported beside its η_r: the largest density
+error, the smallest gap between surfaces [h] and the largest body speed relative to the flow
+over the wall speed, all over the samples; a run that leaves its health limits stops at that
+sample with the reason, is reported and left out of the means. ``--box`` takes another side
+(a multiple of the lattice spacing 0.625 h, see ``scene_rules.lattice_mismatch``). One thread
+per run; prints a Markdown table and writes nothing else.
 """
 import argparse
+import json
 import math
+import time
 
 import numpy as np
 
+from suspsim.errors import NumericalError
 from suspsim.validation.suspension import RATE, relative_viscosity
 
 BOX = 16.875
@@ -27,27 +36,48 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 4.0],
                         metavar=("TRANSIENT", "UNITS"))
+    parser.add_argument("--box", type=float, default=BOX, help=f"cube side [h] (default {BOX})")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a scene key for every run, e.g. run.dt=0.1 or "
+                             "inclusions.lubrication.repulsion=1e5 (repeatable)")
+    parser.add_argument("--shapes", nargs="+", default=["sphere", "sand"],
+                        choices=("sphere", "sand"))
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
+    overrides = {key: json.loads(value) for key, value in
+                 (item.split("=", 1) for item in args.set)}
     means = {}
-    print(f"φ = {args.phi}, box {BOX} h, a = {RADIUS} h, μ = 1, γ̇ = {RATE}, strain "
-          f"{transient:g} + {units}\n| shape | seed | η_r | CPU [s] |\n|---|---|---|---|",
+    settings = "".join(f", {key} = {value}" for key, value in overrides.items())
+    print(f"φ = {args.phi}, box {args.box} h, a = {RADIUS} h, μ = 1, γ̇ = {RATE}, strain "
+          f"{transient:g} + {units}{settings}\n| shape | seed | η_r | CPU [s] | density error | "
+          f"smallest gap [h] | body speed / wall speed |\n|---|---|---|---|---|---|---|",
           flush=True)
-    for shape in ("sphere", "sand"):
+    for shape in args.shapes:
         values = []
         for seed in args.seeds:
-            r = relative_viscosity(shape=shape, phi=args.phi, radius=RADIUS, box=BOX, seed=seed,
-                                   transient=transient, units=units)
+            started = time.process_time()
+            try:
+                r = relative_viscosity(shape=shape, phi=args.phi, radius=RADIUS, box=args.box,
+                                       seed=seed, transient=transient, units=units,
+                                       overrides=overrides)
+            except NumericalError as err:
+                print(f"| {shape} | {seed} | stopped: {err} | "
+                      f"{time.process_time() - started:.0f} | | | |", flush=True)
+                continue
             values.append(r.relative_viscosity)
             print(f"| {shape} | {seed} | {r.relative_viscosity:.3f} ± {r.stderr:.3f} | "
-                  f"{r.cpu_time:.0f} |", flush=True)
+                  f"{r.cpu_time:.0f} | {r.density_error:.3f} | {r.smallest_gap:.3f} | "
+                  f"{r.body_speed:.2f} |", flush=True)
+        if not values:
+            continue
         sem = np.std(values, ddof=1) / math.sqrt(len(values)) if len(values) > 1 else math.nan
         means[shape] = (float(np.mean(values)), float(sem))
-        print(f"| {shape} | mean | {means[shape][0]:.3f} ± {means[shape][1]:.3f} | |",
+        print(f"| {shape} | mean | {means[shape][0]:.3f} ± {means[shape][1]:.3f} | | | | |",
               flush=True)
-    (s, ds), (g, dg) = means["sphere"], means["sand"]
-    ratio = g / s
-    print(f"sand/spheres = {ratio:.3f} ± {ratio * math.hypot(ds / s, dg / g):.3f}")
+    if "sphere" in means and "sand" in means:
+        (s, ds), (g, dg) = means["sphere"], means["sand"]
+        ratio = g / s
+        print(f"sand/spheres = {ratio:.3f} ± {ratio * math.hypot(ds / s, dg / g):.3f}")
 
 
 if __name__ == "__main__":

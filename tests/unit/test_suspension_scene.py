@@ -18,3 +18,13 @@ def test_scene_holds_the_requested_bodies_in_the_newtonian_matrix(shape):
     # the suspension validation's numerics: shifting with the Newtonian bodies' A
     assert scene.numerics.shifting == AUTO_SHIFTING_WITH_INCLUSIONS
     assert scene.total_time == pytest.approx(5.0 / RATE)
+
+
+def test_overrides_set_dotted_scene_keys_and_keep_the_rest():
+    scene = suspension_scene(shape="sand", phi=0.5, radius=2.5, box=16.875, overrides={
+        "run.sound_speed": 1.18, "inclusions.lubrication.min_gap": 0.05})
+    assert scene.run.sound_speed == 1.18
+    assert scene.inclusions.lubrication.min_gap == 0.05
+    # the siblings of an overridden key keep their values
+    assert (scene.inclusions.shape, scene.inclusions.phi) == ("sand", 0.5)
+    assert scene.flow.shear_rate == RATE

@@ -17,6 +17,7 @@ Symbols: σ_xy shear stress [m h^(2−d) τ^-2]; γ̇ shear rate [τ^-1]; μ vis
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Callable
 
 import numpy as np
 
@@ -45,21 +46,35 @@ def _require_health(sim) -> None:
         raise NumericalError(message)
 
 
-def couette_viscosity_ratio(sim, *, transient: float = 1.0, units: int = 3) -> Reading:
+def _chunks(steps: int, size: int) -> list[int]:
+    """``steps`` split into runs of ``size`` and the remainder."""
+    return [size] * (steps // size) + ([steps % size] if steps % size else [])
+
+
+def couette_viscosity_ratio(sim, *, transient: float = 1.0, units: int = 3,
+                            on_sample: Callable[[Any], None] | None = None) -> Reading:
     """σ_xy/(μ(γ̇) γ̇) − 1 of a Couette ``sim`` (a fresh
     :class:`~suspsim.sph.simulation.Simulation`) averaged over ``units`` whole strain units
     after ``transient`` strain units; ``stderr`` is the standard deviation of the strain-unit
-    means over √units. Raises NumericalError if the run left its health limits."""
+    means over √units. Raises NumericalError if the run left its health limits.
+    ``on_sample(sim)``, if given, is called every sampling stride from the start, the transient
+    included, to watch the run (it may raise to stop a run that went wrong)."""
     scene = sim.scene
     rate = scene.flow.shear_rate
     per_unit = max(1, int(round(1.0 / (rate * sim.dt))))
-    sim.advance(int(round(transient * per_unit)))
     stride = max(1, per_unit // SAMPLES_PER_UNIT)
+    transient_steps = int(round(transient * per_unit))
+    for chunk in (_chunks(transient_steps, stride) if on_sample else [transient_steps]):
+        sim.advance(chunk)
+        if on_sample is not None:
+            on_sample(sim)
     per_block = per_unit // stride
     stresses = np.empty(units * per_block)
     for k in range(stresses.size):
         sim.advance(stride)
         stresses[k] = sim.sample()["shear_stress"]
+        if on_sample is not None:
+            on_sample(sim)
     _require_health(sim)
     expected = float(scene.fluid.law.viscosity(rate)) * rate
     blocks = stresses.reshape(units, per_block).mean(axis=1) / expected

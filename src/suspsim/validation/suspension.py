@@ -8,9 +8,16 @@ a relaxed start and the inclusions' defaults.
 from __future__ import annotations
 
 import time
-from typing import NamedTuple
+from typing import Any, Mapping, NamedTuple
 
+import math
+
+import numpy as np
+
+from suspsim.bodies.lubrication_pass import SMALLEST_GAP
+from suspsim.errors import NumericalError
 from suspsim.scene import Scene, scene_from_dict
+from suspsim.sph.lattice import imposed_velocity
 from suspsim.sph.simulation import Simulation
 from suspsim.validation.flows import couette_viscosity_ratio
 
@@ -22,39 +29,83 @@ NUMBER_DENSITY = 4.096
 
 class SuspensionReading(NamedTuple):
     """``relative_viscosity`` σ_xy/(μγ̇) [1], its strain-unit standard error ``stderr`` [1], the
-    ``cpu_time`` of set-up and run [s], ``n_particles`` and the packing's ``phi`` [1]."""
+    ``cpu_time`` of set-up and run [s], ``n_particles``, the packing's ``phi`` [1], and the
+    run's health over its samples (every 1/50 strain unit): the largest fluid
+    ``density_error`` max|ρ/ρ_eq − 1| [1], the ``smallest_gap`` between body surfaces [h] and
+    the largest body speed relative to the imposed flow, ``body_speed``, in units of the wall
+    speed γ̇L_y/2 [1]."""
 
     relative_viscosity: float
     stderr: float
     cpu_time: float
     n_particles: int
     phi: float
+    density_error: float
+    smallest_gap: float
+    body_speed: float
+
+
+class _Watch:
+    """The health extremes of a run, updated at each sample; stops the run (NumericalError
+    with the simulation's reason) at the first sample outside its health limits."""
+
+    def __init__(self) -> None:
+        self.density_error, self.smallest_gap, self.body_speed = 0.0, math.inf, 0.0
+
+    def __call__(self, sim: Simulation) -> None:
+        ok, message = sim.health()
+        if not ok:
+            raise NumericalError(message)
+        scene, bodies = sim.scene, sim.bodies
+        self.density_error = max(self.density_error, sim.sample()["density_error"])
+        if bodies is None:
+            return
+        # the gap of the step just taken (the lubrication pass resets it every step)
+        self.smallest_gap = min(self.smallest_gap, float(sim._lubrication_stats[SMALLEST_GAP]))
+        peculiar = bodies.velocities.copy()
+        peculiar[:, 0] -= imposed_velocity(scene, bodies.centres[:, 1])
+        wall_speed = 0.5 * scene.flow.shear_rate * scene.box[1]
+        self.body_speed = max(self.body_speed,
+                              float(np.sqrt((peculiar ** 2).sum(axis=1)).max()) / wall_speed)
 
 
 def suspension_scene(*, shape: str = "sphere", phi: float, radius: float, box: float,
-                     seed: int = 1, strain: float = 5.0) -> Scene:
+                     seed: int = 1, strain: float = 5.0,
+                     overrides: Mapping[str, Any] | None = None) -> Scene:
     """The scene of bodies of ``shape`` and volume-equivalent ``radius`` [h] packed at ``phi``
     [1] (packing ``seed``) in a cubic periodic box of side ``box`` [h], sheared for ``strain``
-    [1] in the module's Newtonian matrix."""
-    return scene_from_dict({
+    [1] in the module's Newtonian matrix. ``overrides`` maps dotted scene keys to values
+    (e.g. ``{"run.dt": 0.1}``, ``{"inclusions.lubrication.repulsion": 1e5}``)."""
+    data: dict[str, Any] = {
         "dimension": 3, "box": [box] * 3, "number_density": NUMBER_DENSITY, "seed": seed,
         "fluid": {"law": "newtonian", "params": {"mu": 1.0}},
         "flow": {"type": "couette", "shear_rate": RATE},
         "run": {"strain": strain, "start": "linear"},
         "lattice": {"relax": True},
-        "inclusions": {"phi": phi, "radius": radius, "shape": shape}})
+        "inclusions": {"phi": phi, "radius": radius, "shape": shape}}
+    for key, value in (overrides or {}).items():
+        *parents, leaf = key.split(".")
+        block = data
+        for name in parents:
+            block = block.setdefault(name, {})
+        block[leaf] = value
+    return scene_from_dict(data)
 
 
 def relative_viscosity(*, shape: str = "sphere", phi: float, radius: float, box: float,
                        seed: int = 1, transient: float = 1.0, units: int = 4,
-                       threads: int = 1) -> SuspensionReading:
-    """η_r of the :func:`suspension_scene` averaged over ``units`` whole strain units after
-    ``transient`` strain units, on ``threads`` threads. Raises NumericalError if the run left
-    its health limits."""
+                       threads: int = 1,
+                       overrides: Mapping[str, Any] | None = None) -> SuspensionReading:
+    """η_r of the :func:`suspension_scene` (with its ``overrides``) averaged over ``units``
+    whole strain units after ``transient`` strain units, on ``threads`` threads. Raises
+    NumericalError at the first sample (every 1/50 strain unit) outside the run's health
+    limits."""
     scene = suspension_scene(shape=shape, phi=phi, radius=radius, box=box, seed=seed,
-                             strain=transient + units)
+                             strain=transient + units, overrides=overrides)
     started = time.process_time()
     sim = Simulation(scene, threads=threads)
-    reading = couette_viscosity_ratio(sim, transient=transient, units=units)
+    watch = _Watch()
+    reading = couette_viscosity_ratio(sim, transient=transient, units=units, on_sample=watch)
     return SuspensionReading(1.0 + reading.value, reading.stderr,
-                             time.process_time() - started, sim.n_particles, sim.packing_phi)
+                             time.process_time() - started, sim.n_particles, sim.packing_phi,
+                             watch.density_error, watch.smallest_gap, watch.body_speed)
