@@ -171,11 +171,11 @@ def _density_loop(lo, hi, positions, box, offset, start, image_start, neighbours
         own = w0
         first, last = start[i], start[i + 1]
         # _pair writes a row before it knows whether the pair is kept: room for every listed one.
-        if row + (last - first) > row_hi:
+        end = row + (last - first)
+        if end > row_hi:
             pair_end[hi - 1] = -1
             return TABLE_OVERFLOW
         listed = neighbours[first:last]
-        end = row + (last - first)
         js, rows, images = pair_j[row:end], pair_geometry[row:end], pair_image[row:end]
         n_plain = image_start[i] - first
         s = 0

@@ -7,10 +7,9 @@ a relaxed start and the inclusions' defaults.
 """
 from __future__ import annotations
 
+import math
 import time
 from typing import Any, Mapping, NamedTuple
-
-import math
 
 import numpy as np
 
@@ -57,7 +56,7 @@ class _Watch:
         if not ok:
             raise NumericalError(message)
         scene, bodies = sim.scene, sim.bodies
-        self.density_error = max(self.density_error, sim.sample()["density_error"])
+        self.density_error = max(self.density_error, sim._density_error())
         if bodies is None:
             return
         # the gap of the step just taken (the lubrication pass resets it every step)
