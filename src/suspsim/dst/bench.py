@@ -6,7 +6,9 @@ the gap) on a finer lattice: box [3.2, 1] gaps, ``resolution`` fluid particles a
 chosen so that the fluid holds about the requested number of particles (3.2 r² ≈ N, r a
 multiple of 5 so the lattice fits the box; 32,768 → r = 100, 32,000 fluid particles). The
 solver adapts its step every step and rebuilds its lists inside the compiled loop, so the
-figure is whole steps: particle-steps/s counts fluid and wall particles.
+figure is whole steps: particle-steps/s counts fluid and wall particles. The compiled loop has
+no timer, so the cost of its parts is timed outside it on the state after the timed steps
+(:func:`pass_times`).
 """
 from __future__ import annotations
 
@@ -15,7 +17,9 @@ import time
 
 import numpy as np
 
+from suspsim.dst import integrator as _int
 from suspsim.dst.scene import dst_scene_from_dict
+from suspsim.threads import use_threads
 
 #: Name of the scene in ``suspsim bench``.
 SCENE = "dst-2d"
@@ -50,16 +54,62 @@ def array_bytes(obj, seen=None) -> int:
     return 0
 
 
+def pass_times(sim, repeats: int = 5) -> dict[str, float]:
+    """Best-of-``repeats`` wall time [s] of each part of one rate evaluation on ``sim``'s
+    current state, on copies of its work arrays (the run is not changed): the list build
+    (forced), the per-particle state (η, p), the wall and fluid pair passes, and the finish
+    (γ̇, σ, Df/Dt, the wall's acceleration). A step evaluates twice (predictor–corrector);
+    the list build runs only when a particle has moved half the skin."""
+    use_threads(sim.threads)
+    cfg = sim.config
+    x, v, rho, f = sim.positions_all, sim.velocity_all, sim.rho_all.copy(), sim.f_all
+    buf = _int.Buffers(*(a.copy() for a in sim._buffers))
+    lists = _int.ListArrays(*(a.copy() for a in sim._lists))
+    wall = sim.wall.copy()
+
+    def build():
+        lists.force_rebuild[0] = 1
+        return _int.refresh_list(cfg, x, lists)
+
+    calls = {"list build": build,
+             "viscosity and pressure": lambda: _int.particle_state(cfg, v, rho, f, buf),
+             "pair passes": lambda: _int.pair_passes(cfg, x, v, rho, f, wall, buf, lists),
+             "finish": lambda: _int.finish_rates(cfg, f, wall, buf)}
+    best = {}
+    for name, call in calls.items():
+        call()
+        times = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            call()
+            times.append(time.perf_counter() - start)
+        best[name] = min(times)
+    return best
+
+
 def benchmark_dst(n_steps: int, threads: int, particles: int, warm_up: int) -> dict:
     """Time ``n_steps`` steps of the DST scene after ``warm_up`` untimed ones (compilation,
     the start's transient). Returns {scene, n_particles, threads, steps, wall_time_s,
-    particle_steps_per_s, dt (the last step), bytes_per_particle}."""
+    particle_steps_per_s, dt (the last step), rebuilds, rebuild_share, bytes_per_particle,
+    pass_ms (:func:`pass_times`, with "update and checks": the step's remainder, the timed
+    wall time per step less two evaluations and its share of builds)}. rebuild_share is the
+    builds during the timed steps times the timed build, over the timed wall time (an
+    estimate: the loop rebuilds inside compiled code)."""
     sim = dst_bench_scene(particles).build(threads=threads)
     sim.advance(warm_up)
+    builds = sim.rebuild_count
     start = time.perf_counter()
     sim.advance(n_steps)
     wall = time.perf_counter() - start
+    rebuilds = sim.rebuild_count - builds
+    passes = pass_times(sim)
+    build_share = rebuilds * passes["list build"] / wall
+    evaluation = sum(t for name, t in passes.items() if name != "list build")
+    passes["update and checks"] = max(
+        0.0, wall / n_steps - 2.0 * evaluation - rebuilds * passes["list build"] / n_steps)
     return {"scene": SCENE, "n_particles": sim.n_particles, "threads": sim.threads,
             "steps": int(n_steps), "wall_time_s": wall,
             "particle_steps_per_s": sim.n_particles * n_steps / wall, "dt": sim.last_dt,
-            "bytes_per_particle": array_bytes(sim) / sim.n_particles}
+            "rebuilds": rebuilds, "rebuild_share": build_share,
+            "bytes_per_particle": array_bytes(sim) / sim.n_particles,
+            "pass_ms": {name: 1e3 * seconds for name, seconds in passes.items()}}

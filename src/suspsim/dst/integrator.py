@@ -65,9 +65,10 @@ Buffers = namedtuple("Buffers", [
     "pressure", "eta", "v_visc", "drho", "acc", "acc_top", "grad", "grad_c", "lap_f", "grad_f",
     "gdot", "sigma", "df"])
 
-#: Neighbour-list arrays: CSR start/neighbours, sort scratch, positions at the build.
+#: Neighbour-list arrays: CSR start/neighbours, sort scratch, positions at the build, a flag
+#: forcing the next build, and the count of builds so far.
 ListArrays = namedtuple("ListArrays", ["start", "neighbours", "cell_of", "order", "reference",
-                                       "force_rebuild"])
+                                       "force_rebuild", "builds"])
 
 
 @njit(**JIT_OPTIONS)
@@ -90,17 +91,15 @@ def refresh_list(cfg, positions, lists):
         return LIST_OVERFLOW
     lists.reference[:, :] = positions
     lists.force_rebuild[0] = 0
+    lists.builds[0] += 1
     return STEP_OK
 
 
 @njit(**JIT_OPTIONS)
-def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
-    """Rates at the given state into ``buf`` and wall[WALL_ACCELERATION]; returns a code."""
-    code = refresh_list(cfg, positions, lists)
-    if code != STEP_OK:
-        return code
-    nf = cfg.n_fluid
-    for i in range(nf):
+def particle_state(cfg, velocity, rho, f, buf):
+    """Viscosity η_i = η(f_i), Tait pressure p_i and the velocity the viscous terms see, for
+    every fluid particle; returns JAMMED at the first particle with φ ≥ φ_J(f_i)."""
+    for i in range(cfg.n_fluid):
         eta = suspension_viscosity(f[i], cfg.eta_s, cfg.phi, cfg.phi_m, cfg.phi_0)
         if eta < 0.0:
             return JAMMED
@@ -108,6 +107,13 @@ def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
         buf.pressure[i] = tait_pressure(rho[i], cfg.rho0, cfg.c, cfg.p_b)
         for a in range(cfg.dimension):
             buf.v_visc[i, a] = velocity[i, a]
+    return STEP_OK
+
+
+@njit(**JIT_OPTIONS)
+def pair_passes(cfg, positions, velocity, rho, f, wall, buf, lists):
+    """The wall pass then the fluid pass (2D or 3D) on the current list."""
+    nf = cfg.n_fluid
     v_wall = wall[WALL_VELOCITY]
     if cfg.dimension == 3:
         wall_pass_3d(nf, cfg.n_bottom, positions, velocity, rho, buf.pressure, buf.v_visc,
@@ -125,8 +131,14 @@ def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
                    buf.eta, f, cfg.mass, lists.start, lists.neighbours, cfg.lx, cfg.h_sl,
                    cfg.g_x, v_wall, cfg.gradient_correction, buf.drho, buf.acc, buf.acc_top,
                    buf.grad, buf.grad_c, buf.lap_f, buf.grad_f)
+
+
+@njit(**JIT_OPTIONS)
+def finish_rates(cfg, f, wall, buf):
+    """γ̇_i, σ_i and Df_i/Dt of every fluid particle, and the wall's acceleration from the drag
+    the fluid pass gathered (module docstring, items 4 and 5)."""
     drag = 0.0
-    for i in range(nf):
+    for i in range(cfg.n_fluid):
         g = buf.grad[i]
         gdot = shear_rate_3d(g) if cfg.dimension == 3 else shear_rate_2d(g[0], g[1], g[2], g[3])
         buf.gdot[i] = gdot
@@ -138,6 +150,19 @@ def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
         wall[WALL_ACCELERATION] = (cfg.stress * cfg.area - drag) / cfg.wall_mass
     else:
         wall[WALL_ACCELERATION] = 0.0
+
+
+@njit(**JIT_OPTIONS)
+def evaluate(cfg, positions, velocity, rho, f, wall, buf, lists):
+    """Rates at the given state into ``buf`` and wall[WALL_ACCELERATION]; returns a code."""
+    code = refresh_list(cfg, positions, lists)
+    if code != STEP_OK:
+        return code
+    code = particle_state(cfg, velocity, rho, f, buf)
+    if code != STEP_OK:
+        return code
+    pair_passes(cfg, positions, velocity, rho, f, wall, buf, lists)
+    finish_rates(cfg, f, wall, buf)
     return STEP_OK
 
 
@@ -316,4 +341,5 @@ def allocate_lists(n_particles: int, capacity: int, dimension: int = 2) -> ListA
                       neighbours=np.zeros(int(capacity), dtype=np.int64),
                       cell_of=np.zeros(n, dtype=np.int64), order=np.zeros(n, dtype=np.int64),
                       reference=np.zeros((n, int(dimension))),
-                      force_rebuild=np.ones(1, dtype=np.int64))
+                      force_rebuild=np.ones(1, dtype=np.int64),
+                      builds=np.zeros(1, dtype=np.int64))

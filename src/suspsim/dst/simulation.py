@@ -270,6 +270,11 @@ class DSTSimulation:
         return float(self.clock[1])
 
     @property
+    def rebuild_count(self) -> int:
+        """Neighbour-list builds since the list was allocated (start or restore) [1]."""
+        return int(self._lists.builds[0])
+
+    @property
     def n_particles(self) -> int:
         """Fluid and wall particles."""
         return self.n_fluid + 2 * self.n_wall
