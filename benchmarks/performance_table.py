@@ -26,8 +26,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-SCENES = ("fluid-newtonian", "fluid-papanastasiou", "suspension-newtonian",
-          "suspension-papanastasiou", "dst-2d")
+SCENES = ("fluid-newtonian", "fluid-newtonian-unnormalised", "fluid-papanastasiou",
+          "suspension-newtonian", "suspension-papanastasiou", "dst-2d")
 SUSPSIM = Path(sys.executable).with_name("suspsim")
 
 

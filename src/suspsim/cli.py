@@ -106,8 +106,8 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 #: Scenes of ``suspsim bench`` (defined in :mod:`suspsim.sph.bench`).
-BENCH_SCENES = ("fluid-newtonian", "fluid-papanastasiou", "suspension-newtonian",
-                "suspension-papanastasiou", "dst-2d")
+BENCH_SCENES = ("fluid-newtonian", "fluid-newtonian-unnormalised", "fluid-papanastasiou",
+                "suspension-newtonian", "suspension-papanastasiou", "dst-2d")
 _BENCH_COLUMNS = (("scene", "scene", "{}"), ("particles", "n_particles", "{}"),
                   ("threads", "threads", "{}"), ("steps", "steps", "{}"),
                   ("wall s", "wall_time_s", "{:.3g}"),

@@ -96,8 +96,9 @@ def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
                         types.SimpleNamespace(benchmark=benchmark, lattice_side=lattice_side))
     assert main(["-q", "bench", "--steps", "10"]) == 0
     table = capsys.readouterr().out.splitlines()
-    assert len(table) == 6 and "particle-steps/s" in table[0] and "6.55e+05" in table[1]
-    assert [c[0] for c in calls] == ["fluid-newtonian", "fluid-papanastasiou",
+    assert len(table) == 7 and "particle-steps/s" in table[0] and "6.55e+05" in table[1]
+    assert [c[0] for c in calls] == ["fluid-newtonian", "fluid-newtonian-unnormalised",
+                                     "fluid-papanastasiou",
                                      "suspension-newtonian", "suspension-papanastasiou", "dst-2d"]
     assert calls[0][2] == numba.config.NUMBA_NUM_THREADS
     assert main(["-q", "bench", "--scene", "fluid-papanastasiou", "--threads", "1", "--json"]) == 0
@@ -123,6 +124,9 @@ def test_bench_dst_scene_json(tmp_path):
     assert row["scene"] == "dst-2d" and row["steps"] == 3
     assert row["n_particles"] == 160 * 50 + 2 * 4 * 160  # fluid and two 4-layer walls
     assert row["particle_steps_per_s"] > 0 and 100 < row["bytes_per_particle"] < 5000
+    assert set(row["pass_ms"]) == {"list build", "viscosity and pressure", "pair passes",
+                                   "finish", "update and checks"}
+    assert row["rebuilds"] >= 0 and 0.0 <= row["rebuild_share"] < 1.0
 
 
 def test_tiny_real_couette_runs_end_to_end(tmp_path):
@@ -149,3 +153,13 @@ def test_bench_json_lines(tmp_path):
     assert set(rows[0]["pass_ms"]) == {"density", "gradient sums", "gradient finish",
                                        "dissipation sums", "normalisation finish", "force sums",
                                        "force finish"}
+
+
+def test_bench_unnormalised_scene_runs_only_density_and_force():
+    """Without the dissipation normalisation a Newtonian step needs no velocity gradient: the
+    like-for-like scene against a plain SPH loop times only the density and force passes."""
+    from suspsim.sph.bench import benchmark
+
+    row = benchmark("fluid-newtonian-unnormalised", 3, 1, 8000)
+    assert set(row["pass_ms"]) == {"density", "force sums", "force finish"}
+    assert row["density_error"] < 0.05

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
 
@@ -40,13 +40,14 @@ def _arm(q, o):
             q[2, 0] * o[0] + q[2, 1] * o[1] + q[2, 2] * o[2])
 
 
-@njit(**JIT_OPTIONS)
+@njit(parallel=True, **JIT_OPTIONS)
 def place_body_particles(members, body_of, offsets, centres, rotations, velocities, omegas,
                          box, le_offset, shear_rate, positions, particle_velocities):
     """Set x_i and v_i of every body particle i in ``members`` from its body's state, at the
-    image nearest its previous x_i (module docstring). ``rotations`` (B, 3, 3) body → box."""
+    image nearest its previous x_i (module docstring). ``rotations`` (B, 3, 3) body → box.
+    Each k writes only row members[k], so the loop runs in parallel."""
     lx, ly, lz = box[0], box[1], box[2]
-    for k in range(members.shape[0]):
+    for k in prange(members.shape[0]):
         i = members[k]
         b = body_of[i]
         sx, sy, sz = _arm(rotations[b], offsets[i])
