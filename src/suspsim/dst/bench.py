@@ -20,6 +20,7 @@ import numpy as np
 from suspsim.dst import integrator as _int
 from suspsim.dst.scene import dst_scene_from_dict
 from suspsim.threads import use_threads
+from suspsim.timing import best_times
 
 #: Name of the scene in ``suspsim bench``.
 SCENE = "dst-2d"
@@ -75,16 +76,7 @@ def pass_times(sim, repeats: int = 5) -> dict[str, float]:
              "viscosity and pressure": lambda: _int.particle_state(cfg, v, rho, f, buf),
              "pair passes": lambda: _int.pair_passes(cfg, x, v, rho, f, wall, buf, lists),
              "finish": lambda: _int.finish_rates(cfg, f, wall, buf)}
-    best = {}
-    for name, call in calls.items():
-        call()
-        times = []
-        for _ in range(repeats):
-            start = time.perf_counter()
-            call()
-            times.append(time.perf_counter() - start)
-        best[name] = min(times)
-    return best
+    return best_times(calls, repeats)
 
 
 def benchmark_dst(n_steps: int, threads: int, particles: int, warm_up: int) -> dict:

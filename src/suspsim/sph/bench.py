@@ -36,10 +36,11 @@ from suspsim.dst.bench import benchmark_dst
 from suspsim.scene import scene_from_dict
 from suspsim.sph.density import mass_density, summation_density
 from suspsim.sph.simulation import SUPPORT, Simulation
-from suspsim.threads import use_threads
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
                                              _normalisation_finish)
+from suspsim.threads import use_threads
+from suspsim.timing import best_times
 
 #: Untimed steps before timing: compilation, and the first relaxation of the jittered lattice
 #: (density error ≈ 14 % at step 5, ≈ 1 % from step ~50 on).
@@ -181,13 +182,4 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     calls["force finish"] = lambda: force_finish(
         sim._force_acc, sim._x, sim._rho, sim._inverse_moment, sim._gradient, sim._mass,
         sim._bulk_gradient, sim._body_force, box[1], sim._a_new)
-    best = {}
-    for name, call in calls.items():
-        call()
-        times = []
-        for _ in range(repeats):
-            start = time.perf_counter()
-            call()
-            times.append(time.perf_counter() - start)
-        best[name] = min(times)
-    return best
+    return best_times(calls, repeats)
