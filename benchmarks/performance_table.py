@@ -9,7 +9,8 @@ the first run of a session compiles), one after the other, so that nothing else 
 shares the cores. Prints two Markdown tables:
 
 1. particle-steps/s of every ``suspsim bench`` scene (32,768-particle box) on each thread
-   count, with the suspension scenes' cost per particle-step relative to fluid-newtonian;
+   count, with each suspension scene's cost per particle-step relative to the fluid scene of
+   its matrix;
 2. particle-steps/s and bytes per particle of ``fluid-papanastasiou`` for each box size
    ``--particles`` (k³ lattice sites, side k/1.6 h) on each thread count, and the spread
    max/min − 1 of the throughput over the sizes from 32,768 up.
@@ -43,17 +44,20 @@ def bench(scene: str, threads: int, steps: int, particles: int) -> dict:
 
 
 def speed_table(runs: dict, threads: list[int]) -> str:
-    """Markdown: M particle-steps/s per scene and thread count, suspensions relative."""
+    """Markdown: M particle-steps/s per scene and thread count; each suspension's cost per
+    particle-step relative to the fluid scene of its matrix (suspension-X / fluid-X)."""
     head = "| scene | particles | " + " | ".join(f"{t} thread{'s' * (t > 1)}" for t in threads)
-    lines = [head + " | cost per particle-step / fluid-newtonian |",
+    lines = [head + " | cost per particle-step / the fluid of its matrix |",
              "|---|---|" + "---|" * len(threads) + "---|"]
     for scene in SCENES:
         rates = [runs[scene, t]["particle_steps_per_s"] for t in threads]
-        base = [runs["fluid-newtonian", t]["particle_steps_per_s"] for t in threads]
-        relative = " / ".join(f"{b / r:.2f}" for b, r in zip(base, rates))
+        relative = ""
+        if scene.startswith("suspension-"):
+            fluid = scene.replace("suspension-", "fluid-", 1)
+            base = [runs[fluid, t]["particle_steps_per_s"] for t in threads]
+            relative = " / ".join(f"{b / r:.2f}" for b, r in zip(base, rates)) + f" ({fluid})"
         lines.append(f"| {scene} | {runs[scene, threads[0]]['n_particles']:,} | "
-                     + " | ".join(f"{r / 1e6:.2f} M" for r in rates)
-                     + f" | {relative if scene.startswith('suspension') else ''} |")
+                     + " | ".join(f"{r / 1e6:.2f} M" for r in rates) + f" | {relative} |")
     return "\n".join(lines)
 
 

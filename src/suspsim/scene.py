@@ -106,6 +106,7 @@ class NumericsSpec:
 
     bulk_correction: bool
     viscous_normalisation: bool
+    normalisation_interval: int
     wi_target: float
     shifting: float
     shifting_rate: float

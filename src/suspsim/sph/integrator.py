@@ -30,7 +30,7 @@ from suspsim.sph.neighbours import needs_rebuild
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
-                                             _normalisation_finish)
+                                             _normalisation_finish, normalisation_due)
 
 #: Groot–Warren λ [seed 000 Eq. 23].
 LAMBDA = 0.5
@@ -69,7 +69,8 @@ def kick(velocities, accel, accel_new, dt):
 @njit(**JIT_OPTIONS)
 def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours,
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
-                  law_params, newtonian, velocity_gradient, smooth_rate, normalise, alpha, beta,
+                  law_params, newtonian, velocity_gradient, smooth_rate, normalise,
+                  normalisation_interval, normalisation_age, alpha, beta,
                   bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
                   pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
                   inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
@@ -84,7 +85,9 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     ``velocity_gradient`` runs the gradient pass (needed by a non-Newtonian law or the
     normalisation); ``smooth_rate`` evaluates a non-Newtonian law at the kernel-smoothed rate
     (``terms.rate_smoothing``); ``normalise`` the normalisation pass (else μ̂ must equal μ on
-    entry);
+    entry); a Newtonian fluid runs the gradient and normalisation passes only on the steps
+    :func:`~suspsim.sph.terms.velocity_pass.normalisation_due` picks from
+    ``normalisation_interval`` and ``normalisation_age`` and holds μ̂ in between;
     ``bulk_gradient`` the ∇a sums (B on and μ varying). ``has_bodies``: the scene has rigid
     bodies, whose particles (``body_of`` (N,) ≥ 0; −1 for fluid) take their density from the
     fluid around them (``density.body_particle_density``) and skip pairs inside their own
@@ -100,7 +103,9 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     if has_bodies:
         body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho,
                               rho_eq, c2, mass, dissipation, diss_acc, volume)
-    if velocity_gradient:
+    held = (normalise and newtonian
+            and not normalisation_due(normalisation_age, normalisation_interval))
+    if velocity_gradient and not held:
         _gradient_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted,
                        volume, shear_ly, dimension, grad_acc, scratch_15, bounds)
         _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian or smooth_rate,
@@ -111,7 +116,7 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                                     gradient, body_of, law_code, law_params,
                                     grad_acc[:RATE_WIDTH * rho.shape[0]], scratch_15, bounds,
                                     gdot, viscosity)
-    if normalise:
+    if normalise and not held:
         if alpha != 0.0:
             _dissipation_sums(pair_start, pair_end, pair_j, geometry, volume, strain, diss_acc,
                               scratch_1, bounds)
@@ -132,7 +137,7 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   positions, velocities, accel, predicted, accel_new, box, nl_start,
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
-                  smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient, has_bodies,
+                  smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta, bulk_factor, bulk_gradient, has_bodies,
                   body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
                   pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
                   viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
@@ -157,7 +162,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
         code = accelerations(
             positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
             mass, rho_eq, c2, shear_rate, body_force, dimension, law_code, law_params, newtonian,
-            velocity_gradient, smooth_rate, normalise, alpha, beta, bulk_factor, bulk_gradient,
+            velocity_gradient, smooth_rate, normalise, normalisation_interval, normalisation_age,
+            alpha, beta, bulk_factor, bulk_gradient,
             has_bodies, body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
             pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation,
             gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,

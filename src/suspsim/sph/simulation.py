@@ -176,6 +176,7 @@ class Simulation:
             self._relist_from_reference()
             self._members = np.flatnonzero(self._body_of >= 0)
             self._rho_eq = float(_state.get("rho_eq", self._rho_eq))
+            self._normalisation_age[0] = int(_state.get("normalisation_age", 0))
         log.info("simulation: %d particles, dt = %.4g, c = %.4g, %d chunk(s) on %d thread(s)",
                  self.n_particles, self.dt, self.sound_speed, self._n_chunks, self.threads)
 
@@ -196,6 +197,8 @@ class Simulation:
         self._mu = np.full(n, viscosity)
         self._mu_hat = np.full(n, viscosity)
         self._factor = np.ones(n)
+        # Steps still to hold s (``velocity_pass.normalisation_due``); 0: update on the next.
+        self._normalisation_age = np.zeros(1, dtype=np.int64)
         self._gradient = np.zeros((n, 9))
         self._inverse_moment = np.zeros((n, 6))
         self._moment_trace = np.zeros(n)
@@ -263,6 +266,8 @@ class Simulation:
                 log.info("neighbour list overflow; capacity factor %.3g", factor)
                 self._allocate_list(factor)
         self._build_time = time
+        # The held s is per particle, and the rebuild reordered the particles.
+        self._normalisation_age[0] = 0
         if self.bodies is not None:
             self._members = np.flatnonzero(self._body_of >= 0)
             self.bodies.wrap(self._box, self._offset(time), self._rate)
@@ -286,7 +291,8 @@ class Simulation:
         return (self._box, nl.start, nl.image_start, nl.neighbours, self._kernel, SUPPORT,
                 self._mass, self._rho_eq, self.sound_speed ** 2, self._rate, self._body_force,
                 s.dimension, self._law.code, self._law.packed, self._newtonian,
-                self._velocity_gradient, self._smooth_rate, self._normalise, self._alpha,
+                self._velocity_gradient, self._smooth_rate, self._normalise,
+                self.scene.numerics.normalisation_interval, self._normalisation_age, self._alpha,
                 self._beta, self._bulk_factor, self._bulk_gradient, self.bodies is not None,
                 self._body_of,
                 self._rho, self._volume,
@@ -621,7 +627,8 @@ class Simulation:
         out = {name: getattr(self, attribute).copy() for name, attribute in _STATE_ARRAYS.items()}
         out.update(time=self.time, step_count=self.step_count, dt=self.dt,
                    sound_speed=self.sound_speed, build_time=self._build_time,
-                   n_chunks=self._n_chunks, rho_eq=self._rho_eq)
+                   n_chunks=self._n_chunks, rho_eq=self._rho_eq,
+                   normalisation_age=int(self._normalisation_age[0]))
         if self.bodies is not None:
             out.update(bodies=self.bodies.state(), body_volume=self._body_volume,
                        body_radii=self._body_radii.copy(),

@@ -7,14 +7,15 @@ from suspsim.validation.flows import couette_viscosity_ratio
 
 
 def couette_scene(dim=3, side=5.0, number_density=4.096, law="newtonian", params=None,
-                  rate=0.05, jitter=0.0, normalise=True, bulk=True, seed=1, **run):
+                  rate=0.05, jitter=0.0, normalise=True, bulk=True, seed=1, interval=2, **run):
     run_keys = {"strain": 1.0, **run}
     return scene_from_dict({
         "dimension": dim, "box": [side] * dim, "number_density": number_density,
         "fluid": {"law": law, "params": params or {"mu": 1.0}},
         "flow": {"type": "couette", "shear_rate": rate}, "run": run_keys,
         "lattice": {"jitter": jitter}, "seed": seed,
-        "numerics": {"viscous_normalisation": normalise, "bulk_correction": bulk}})
+        "numerics": {"viscous_normalisation": normalise, "bulk_correction": bulk,
+                     "normalisation_interval": interval}})
 
 
 def relaxed_simulation(dim=3, side=5.0, number_density=4.096, jitter=0.0, relax_steps=0,
@@ -39,6 +40,7 @@ def evaluate(sim, velocity, viscosity, normalise, bulk_gradient=False):
     sim._velocity_gradient = True
     sim._bulk_gradient = bulk_gradient
     sim.sound_speed = 0.0
+    sim._normalisation_age[0] = 0  # s of these fields, not one held from an earlier step
     out = np.zeros_like(sim._x)
     sim._compute_accelerations(sim._v, out)
     return xi, out * sim._rho[:, None], sim._gradient.reshape(-1, 3, 3).copy(), sim._gdot.copy()

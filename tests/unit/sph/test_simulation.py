@@ -51,8 +51,11 @@ def test_momentum_is_conserved_to_round_off(law, params, bulk):
     np.testing.assert_allclose(peculiar_momentum(sim) - before, 0.0, atol=1e-12 * scale)
 
 
-def test_resume_from_state_is_bit_for_bit():
-    scene = couette_scene(law="papanastasiou", params=PAPANASTASIOU, rate=0.1, jitter=0.02)
+@pytest.mark.parametrize("law, params, interval", [("papanastasiou", PAPANASTASIOU, 2),
+                                                   ("newtonian", {"mu": 1.0}, 3)])
+def test_resume_from_state_is_bit_for_bit(law, params, interval):
+    """Also in the middle of a Newtonian scene's held normalisation (40 steps, k = 3)."""
+    scene = couette_scene(law=law, params=params, rate=0.1, jitter=0.02, interval=interval)
     reference = Simulation(scene, threads=2)
     reference.advance(40)
     state = reference.state()
