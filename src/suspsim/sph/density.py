@@ -307,9 +307,32 @@ def summation_density(positions, box, offset, start, image_start, neighbours, ke
     return TABLE_OK
 
 
-@njit(**JIT_OPTIONS)
+@njit(inline="always", **JIT_OPTIONS)
+def _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho, rho_eq,
+                  c2, acc):
+    """acc[2 j] += W, acc[2 j + 1] += W P_f over the fluid–body pairs of particles lo..hi−1,
+    for the body particle j of each pair (either end)."""
+    for i in range(lo, hi):
+        body_i = body_of[i]
+        p_i = c2 * (rho[i] - rho_eq)
+        for k in range(pair_start[i], pair_end[i]):
+            j = pair_j[k]
+            if (body_i < 0) == (body_of[j] < 0):
+                continue
+            row = geometry[k]
+            w = kernel_w(kernel, math.sqrt(row[DX] * row[DX] + row[DY] * row[DY]
+                                           + row[DZ] * row[DZ]), h)
+            if body_i >= 0:
+                acc[2 * i] += w
+                acc[2 * i + 1] += w * c2 * (rho[j] - rho_eq)
+            else:
+                acc[2 * j] += w
+                acc[2 * j + 1] += w * p_i
+
+
+@njit(parallel=True, **JIT_OPTIONS)
 def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho, rho_eq,
-                          c2, mass, weight, weighted, volume):
+                          c2, mass, acc, scratch, bounds, volume):
     """Density of rigid-body particles from the pressure of the fluid around them.
 
     A body particle j takes the Shepard average of its fluid neighbours' pressures,
@@ -318,32 +341,26 @@ def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kerne
     ρ_j = ρ_eq + P_j/c², V_j = m/ρ_j. Its own summation density would instead reflect how the
     body's lattice meets the fluid's (shell particles sit 5–10 % below ρ_eq after the start's
     relaxation, a tension that pulls fluid onto the surface and kept the relaxation from
-    converging). A body particle without fluid neighbours gets ρ_eq. One serial sweep of the
-    pair table; ``weight``, ``weighted`` (N,) scratch.
+    converging). A body particle without fluid neighbours gets ρ_eq. One sweep of the pair
+    table in the chunks of the density pass (``bounds``; pattern of ``chunks``): ``acc``
+    (2N,) holds (Σ W, Σ W P_f) per particle, ``scratch`` (T − 1, ≥ 2N) the other chunks'.
     """
-    n = rho.shape[0]
-    for i in range(n):
-        weight[i] = 0.0
-        weighted[i] = 0.0
-    for i in range(n):
-        body_i = body_of[i]
-        p_i = c2 * (rho[i] - rho_eq)
-        for k in range(pair_start[i], pair_end[i]):
-            j = pair_j[k]
-            body_j = body_of[j]
-            if (body_i < 0) == (body_j < 0):
-                continue
-            row = geometry[k]
-            w = kernel_w(kernel, math.sqrt(row[DX] * row[DX] + row[DY] * row[DY]
-                                           + row[DZ] * row[DZ]), h)
-            if body_i >= 0:
-                weight[i] += w
-                weighted[i] += w * c2 * (rho[j] - rho_eq)
-            else:
-                weight[j] += w
-                weighted[j] += w * p_i
-    for i in range(n):
+    n_chunks = scratch.shape[0] + 1
+    for c in prange(n_chunks):
+        lo, hi = bounds[c], bounds[c + 1]
+        if c == 0:
+            acc[:] = 0.0
+            _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kernel, h,
+                          rho, rho_eq, c2, acc)
+        else:
+            buffer = scratch[c - 1]
+            buffer[2 * lo:] = 0.0
+            _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kernel, h,
+                          rho, rho_eq, c2, buffer)
+    add_chunk_buffers(acc, scratch, bounds, n_chunks, 2)
+    for i in prange(rho.shape[0]):
         if body_of[i] >= 0:
-            p = weighted[i] / weight[i] if weight[i] > 0.0 else 0.0
+            weight = acc[2 * i]
+            p = acc[2 * i + 1] / weight if weight > 0.0 else 0.0
             rho[i] = rho_eq + p / c2
             volume[i] = mass / rho[i]

@@ -101,8 +101,10 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
         return code
     mass_density(rho, mass, volume)
     if has_bodies:
+        n = rho.shape[0]
         body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho,
-                              rho_eq, c2, mass, dissipation, diss_acc, volume)
+                              rho_eq, c2, mass, grad_acc[:2 * n], scratch_15[:, :2 * n], bounds,
+                              volume)
     held = (normalise and newtonian
             and not normalisation_due(normalisation_age, normalisation_interval))
     if velocity_gradient and not held:

@@ -125,10 +125,10 @@ def sort_by_cell(positions, box, cells, cell_of, order, cell_start):
     cell_start[n_cells] = n_particles
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def apply_permutation(source, order, destination):
     """destination[k] = source[order[k]] along the first axis (1D or 2D arrays)."""
-    for k in range(order.shape[0]):
+    for k in prange(order.shape[0]):
         destination[k] = source[order[k]]
 
 
