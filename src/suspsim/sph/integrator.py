@@ -139,8 +139,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   positions, velocities, accel, predicted, accel_new, box, nl_start,
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
-                  smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta, bulk_factor, bulk_gradient, has_bodies,
-                  body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
+                  smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta,
+                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
                   pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
                   viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
                   scratch_15, scratch_6, bounds, virial):

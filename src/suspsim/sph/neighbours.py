@@ -198,6 +198,12 @@ def _gather_candidates(cell, positions, box, offset, cutoff, cells, cell_start, 
     return n_plain, m
 
 
+@njit(inline="always", cache=True)
+def _listed(i, j, half):
+    """Whether candidate j of particle i belongs in its list: j > i (half list) or j ≠ i."""
+    return (j > i) if half else (j != i)
+
+
 @njit(cache=True, parallel=True)
 def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start, neighbours,
            half, share_lo, used, buf_x, buf_y, buf_z, buf_j, buf_d):
@@ -237,12 +243,12 @@ def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start
                     for k in range(n_plain):
                         j = bj[k]
                         neighbours[slot] = j
-                        slot += (bd[k] < rc2) & ((j > i) if half else (j != i))
+                        slot += (bd[k] < rc2) & _listed(i, j, half)
                     image_start[i] = slot
                     for k in range(n_plain, n_cand):
                         j = bj[k]
                         neighbours[slot] = j
-                        slot += (bd[k] < rc2) & ((j > i) if half else (j != i))
+                        slot += (bd[k] < rc2) & _listed(i, j, half)
                 else:
                     for k in range(n_cand):
                         if k == n_plain:
@@ -250,7 +256,7 @@ def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start
                         j = bj[k]
                         if slot < slot_end:
                             neighbours[slot] = j
-                        slot += (bd[k] < rc2) & ((j > i) if half else (j != i))
+                        slot += (bd[k] < rc2) & _listed(i, j, half)
                     if n_plain == n_cand:
                         image_start[i] = slot
         used[b] = slot - share_lo[b]

@@ -4,8 +4,9 @@
 (``timestep``, or the scene's values), allocates every buffer once, and advances with the
 Groot–Warren integrator (``integrator``). Only what the scene needs is computed: the velocity
 gradient pass runs for a non-Newtonian law or the dissipation normalisation, the normalisation
-pass when ``numerics.viscous_normalisation`` is on, the ∇a sums when ``numerics.bulk_correction``
-is on and μ varies. Couette flow uses Lees–Edwards boundaries; Poiseuille a periodic box with
+pass when ``numerics.viscous_normalisation`` is on (for a Newtonian fluid, whose only use of
+both is the factor s, every ``numerics.normalisation_interval`` steps), the ∇a sums when
+``numerics.bulk_correction`` is on and μ varies. Couette flow uses Lees–Edwards boundaries; Poiseuille a periodic box with
 the split body force (SPEC §2.7).
 
 Rigid inclusions (``scene.inclusions``, SPEC §3): :mod:`~suspsim.sph.inclusions` builds the
