@@ -53,7 +53,7 @@ from suspsim.sph.inclusions import scene_packing
 from suspsim.sph.simulation import Simulation
 from suspsim.sph.stress import VXY, kinetic_tensor
 from suspsim.validation.flows import couette_viscosity_ratio
-from suspsim.validation.suspension import RATE, _Watch, suspension_scene
+from suspsim.validation.suspension import RATE, HealthWatch, suspension_scene
 
 BOX = 16.875
 RADIUS = 2.5
@@ -179,7 +179,7 @@ class StressSplit:
     transient (the same samples couette_viscosity_ratio averages)."""
 
     def __init__(self, transient_time: float) -> None:
-        self.watch = _Watch()
+        self.watch = HealthWatch()
         self.transient_time = transient_time
         self.parts: list[tuple[float, float, float, float]] = []
 

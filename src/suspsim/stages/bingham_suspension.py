@@ -42,7 +42,7 @@ from ..run import run_scene
 from ..scene import scene_from_dict
 from ..scene_rules import lattice_mismatch
 from .pack import STUDY_MIN_GAP, Particles, describe_packing, pack_to_file
-from .simulate import _resumable, check_packing
+from .simulate import check_packing, resumable
 
 log = logging.getLogger(__name__)
 
@@ -213,5 +213,5 @@ def simulate_suspension(job: Mapping[str, Any], packing: str | os.PathLike | Non
     law = scene.fluid.law
     log.info("%s, seed %d: %s %s, mu(gdot_sim) = %.12g", label, job["seed"], law.name,
              dict(law.params), float(law.viscosity(scene.flow.shear_rate)))
-    out = run_scene(scene, out_nc, resume=_resumable(Path(out_nc), scene), threads=threads)
+    out = run_scene(scene, out_nc, resume=resumable(Path(out_nc), scene), threads=threads)
     log.info("wrote %s", out)

@@ -200,7 +200,7 @@ def simulate_run(fit_json: str | os.PathLike, out_nc: str | os.PathLike, *, shea
              mapping.time_scale, mapping.viscosity_scale, mapping.reynolds_number,
              mapping.reynolds_length, dict(scene.fluid.law.params))
     try:
-        run_scene(scene, sim_path, resume=_resumable(sim_path, scene), threads=threads)
+        run_scene(scene, sim_path, resume=resumable(sim_path, scene), threads=threads)
     except NumericalError as err:
         raise NumericalError(f"{err}. {STUDY_NUMERICS_HINT}") from None
     run = read_run(sim_path)
@@ -304,7 +304,7 @@ def with_physical_results(run: xr.Dataset, mapping: UnitMapping, *, scene: Scene
     return out
 
 
-def _resumable(sim_path: Path, scene: Scene) -> bool:
+def resumable(sim_path: Path, scene: Scene) -> bool:
     """True when a checkpoint of this very scene is waiting; one of another scene is removed."""
     ckpt = checkpoint_path(sim_path)
     if not ckpt.exists():

@@ -44,7 +44,7 @@ class SuspensionReading(NamedTuple):
     body_speed: float
 
 
-class _Watch:
+class HealthWatch:
     """The health extremes of a run, updated at each sample; stops the run (NumericalError
     with the simulation's reason) at the first sample outside its health limits."""
 
@@ -103,7 +103,7 @@ def relative_viscosity(*, shape: str = "sphere", phi: float, radius: float, box:
                              strain=transient + units, overrides=overrides)
     started = time.process_time()
     sim = Simulation(scene, threads=threads)
-    watch = _Watch()
+    watch = HealthWatch()
     reading = couette_viscosity_ratio(sim, transient=transient, units=units, on_sample=watch)
     return SuspensionReading(1.0 + reading.value, reading.stderr,
                              time.process_time() - started, sim.n_particles, sim.packing_phi,
