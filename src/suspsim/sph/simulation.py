@@ -203,8 +203,9 @@ class Simulation:
         self._gradient = np.zeros((n, 9))
         self._inverse_moment = np.zeros((n, 6))
         self._moment_trace = np.zeros(n)
-        # The passes' accumulators and chunk buffers live one pass each (density → gradient →
-        # smoothing → dissipation → force → body forces → shifting, one after the other), so
+        # The passes' accumulators and chunk buffers live one pass each (density → body
+        # density → gradient → smoothing → dissipation → force → body forces → shifting, one
+        # after the other), so
         # the narrower ones, and the force pass's pressure scratch, are views of the 15-wide
         # ones: 176 bytes per particle and chunk fewer. The force sums stay readable until the
         # next step (bodies read them).

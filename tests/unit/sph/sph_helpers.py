@@ -7,15 +7,17 @@ from suspsim.validation.flows import couette_viscosity_ratio
 
 
 def couette_scene(dim=3, side=5.0, number_density=4.096, law="newtonian", params=None,
-                  rate=0.05, jitter=0.0, normalise=True, bulk=True, seed=1, interval=2, **run):
+                  rate=0.05, jitter=0.0, normalise=True, bulk=True, seed=1, interval=None, **run):
     run_keys = {"strain": 1.0, **run}
+    numerics = {"viscous_normalisation": normalise, "bulk_correction": bulk}
+    if interval is not None:
+        numerics["normalisation_interval"] = interval
     return scene_from_dict({
         "dimension": dim, "box": [side] * dim, "number_density": number_density,
         "fluid": {"law": law, "params": params or {"mu": 1.0}},
         "flow": {"type": "couette", "shear_rate": rate}, "run": run_keys,
         "lattice": {"jitter": jitter}, "seed": seed,
-        "numerics": {"viscous_normalisation": normalise, "bulk_correction": bulk,
-                     "normalisation_interval": interval}})
+        "numerics": numerics})
 
 
 def relaxed_simulation(dim=3, side=5.0, number_density=4.096, jitter=0.0, relax_steps=0,

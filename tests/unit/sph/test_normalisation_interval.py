@@ -2,6 +2,7 @@
 recomputed on every k-th step and after every rebuild, held in between, and holding it moves the
 stress by far less than the normalisation corrects."""
 import numpy as np
+
 from sph_helpers import couette_scene
 from suspsim.sph.simulation import Simulation
 from suspsim.sph.terms.velocity_pass import normalisation_due

@@ -332,4 +332,3 @@ def normalisation_due(age, interval):
         return True
     age[0] -= 1
     return False
-
