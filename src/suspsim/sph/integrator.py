@@ -74,9 +74,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
                   pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
                   inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
-                  viscosity_hat,
-                  grad_acc, diss_acc, force_acc, scratch_1, scratch_15, scratch_6, bounds, virial,
-                  accel_out):
+                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
+                  force_scratch, bounds, virial, accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
 
     Returns ``density.TABLE_OK``, or ``density.TABLE_OVERFLOW`` straight after the density pass
@@ -128,7 +127,7 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
         viscosity_hat[:] = viscosity
     force_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
                volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
-               shear_ly, body_of, pressure, force_acc, scratch_6, bounds, virial)
+               shear_ly, body_of, pressure, force_acc, force_scratch, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
     return TABLE_OK
@@ -140,10 +139,11 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta,
-                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
-                  pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
-                  viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
-                  scratch_15, scratch_6, bounds, virial):
+                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
+                  pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
+                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
+                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
+                  force_scratch, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, stop).
 
     stop is :data:`DONE`, or :data:`REBUILD` or :data:`GROW_TABLE`: the drift of step
@@ -169,7 +169,7 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
             has_bodies, body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
             pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation,
             gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
-            scratch_15, scratch_6, bounds, virial, accel_new)
+            scratch_15, force_scratch, bounds, virial, accel_new)
         if code != TABLE_OK:
             return done, GROW_TABLE
         kick(velocities, accel, accel_new, dt)

@@ -47,7 +47,7 @@ from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbo
                                     build_neighbour_list, needs_rebuild, raise_for_code,
                                     rebuild_neighbour_list, sort_by_cell)
 from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
-from suspsim.sph.terms.force_pass import FORCE_WIDTH
+from suspsim.sph.terms.force_pass import force_width
 from suspsim.sph.terms.shifting import shift_particles
 from suspsim.sph.terms.velocity_pass import GRADIENT_WIDTH
 from suspsim.sph.terms.viscous import bulk_factor, viscous_weights
@@ -205,24 +205,19 @@ class Simulation:
         self._moment_trace = np.zeros(n)
         # The passes' accumulators and chunk buffers live one pass each (density → body
         # density → gradient → smoothing → dissipation → force → body forces → shifting, one
-        # after the other), so
-        # the narrower ones, and the force pass's pressure scratch, are views of the 15-wide
-        # ones: 176 bytes per particle and chunk fewer. The force sums stay readable until the
-        # next step (bodies read them).
+        # after the other), so the narrower ones, and the force pass's pressure scratch, are
+        # views of the 15-wide ones: 176 bytes per particle and chunk fewer. The force sums
+        # stay readable until the next step (bodies and shifting read them).
         self._grad_acc = np.zeros(n * GRADIENT_WIDTH)
-        self._force_acc = self._grad_acc[:n * FORCE_WIDTH]
         self._diss_acc = self._grad_acc[(GRADIENT_WIDTH - 1) * n:]
-        self._pressure = self._grad_acc[FORCE_WIDTH * n:(FORCE_WIDTH + 1) * n]
         self._scratch_15 = np.zeros((t - 1, n * GRADIENT_WIDTH))
-        self._scratch_6 = self._scratch_15.reshape(-1)[:(t - 1) * n * FORCE_WIDTH].reshape(
-            t - 1, n * FORCE_WIDTH)
         self._scratch_1 = self._scratch_15.reshape(-1)[:(t - 1) * n].reshape(t - 1, n)
+        self._force_views()
         self._bounds = np.zeros(t + 1, dtype=np.int64)
         self._virial = np.zeros((t, 5))
         self._body_of = np.full(n, -1, dtype=np.int64)
         self._offsets = np.zeros((n if self.bodies is not None else 0, 3))
         self._members = np.zeros(0, dtype=np.int64)
-        self._grad_c = np.zeros(3 * n if self._shifting > 0.0 else 0)
         self._body_virial = np.zeros(5)
         self._lubrication_virial = np.zeros(5)
         self._lubrication_stats = np.array([np.inf, 0.0, 0.0])
@@ -230,6 +225,18 @@ class Simulation:
         self._table = allocate_pair_table(n, pair_capacity(
             n, self.scene.number_density, SUPPORT, self.scene.dimension,
             self._nlist.neighbours.shape[0]))
+
+    def _force_views(self) -> None:
+        """The force pass's accumulator, chunk buffers and pressure scratch as views of the
+        gradient pass's, :func:`~suspsim.sph.terms.force_pass.force_width` values per particle
+        for the current bulk-gradient and shifting settings."""
+        n, rows = self.n_particles, self._scratch_15.shape[0]
+        width = force_width(self._bulk_gradient, self._shifting > 0.0)
+        self._force_width = width
+        self._force_acc = self._grad_acc[:n * width]
+        self._pressure = self._grad_acc[width * n:(width + 1) * n]
+        self._force_scratch = self._scratch_15.reshape(-1)[:rows * n * width].reshape(
+            rows, n * width)
 
     def _allocate_list(self, capacity_factor: float) -> None:
         self._nlist = allocate_neighbour_list(self.n_particles, self._box, SUPPORT, SKIN,
@@ -303,7 +310,7 @@ class Simulation:
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
                 self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
                 self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,
-                self._scratch_6, self._bounds, self._virial)
+                self._force_scratch, self._bounds, self._virial)
 
     def _compute_accelerations(self, predicted, out, time: float | None = None) -> None:
         """a = f(x, ``predicted``)/m into ``out`` at ``time`` (default: now), growing the pair
@@ -372,7 +379,8 @@ class Simulation:
         b = self.bodies.count
         forces, torques = np.zeros((b, 3)), np.zeros((b, 3))
         body_force_torque(self._members, self._body_of, self._offsets, rotations,
-                          self._force_acc, FORCE_WIDTH, forces, torques, self._body_virial)
+                          self._force_acc, self._force_width, forces, torques,
+                          self._body_virial)
         return forces, torques
 
     def _lubrication_setup(self):
@@ -448,11 +456,9 @@ class Simulation:
                 self._place_bodies(rotations, bodies.velocities, bodies.angular_velocities(),
                                    time, self._v)
             if self._shifting > 0.0:
-                tb = self._table
-                shift_particles(tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry,
-                                self._volume, self._body_of, self._shifting,
-                                self._shifting_rate, dt, SUPPORT, self._gradient, self._grad_c, self._scratch_15,
-                                self._bounds, self._x, self._v)
+                shift_particles(self._force_acc, self._body_of, self._shifting,
+                                self._shifting_rate, dt, SUPPORT, self._gradient, self._x,
+                                self._v)
             if self._mean_reference:
                 self._rho_eq = self._fluid_mean_density()
             self.step_count += 1

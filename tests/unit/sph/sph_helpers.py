@@ -41,6 +41,7 @@ def evaluate(sim, velocity, viscosity, normalise, bulk_gradient=False):
     sim._normalise = normalise
     sim._velocity_gradient = True
     sim._bulk_gradient = bulk_gradient
+    sim._force_views()
     sim.sound_speed = 0.0
     sim._normalisation_age[0] = 0  # s of these fields, not one held from an earlier step
     out = np.zeros_like(sim._x)

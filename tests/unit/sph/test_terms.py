@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from suspsim.sph.kernels import LUCY_2D, LUCY_3D, kernel_f
-from suspsim.sph.terms.force_pass import FORCE_WIDTH, force_sums
+from suspsim.sph.terms.force_pass import force_sums, force_width
 from suspsim.sph.terms.gradient import corrected_gradient, invert_symmetric, shear_rate
 from suspsim.sph.terms.normalisation import (continuum_dissipation, moment_dissipation,
                                              normalisation_factor, pair_dissipation,
@@ -47,13 +47,14 @@ def _two_particle_force(body_of, viscosity):
     d = np.array([0.3, 0.2, -0.1])
     f = kernel_f(LUCY_3D, float(np.linalg.norm(d)), 1.0)
     velocity = np.array([[0.1, -0.2, 0.05], [0.0, 0.3, 0.0]])
-    acc = np.zeros(2 * FORCE_WIDTH)
+    width = force_width(False, False)
+    acc = np.zeros(2 * width)
     alpha, beta = viscous_weights(3, True)
     force_sums(np.array([0, 1, 1]), np.array([1, 1]), np.array([1]), np.array([[*d, f]]),
                np.array([1, 1]), np.zeros(1, dtype=np.int64), velocity, np.full(2, 4.0),
                np.full(2, 0.25), np.asarray(viscosity, dtype=float), 1.0, 4.0, 0.0, alpha,
                beta, -5.0 / 3.0, False, 0.0, np.asarray(body_of), np.zeros(2), acc,
-               np.zeros((0, 2 * FORCE_WIDTH)), np.array([0, 2]), np.zeros((1, 5)))
+               np.zeros((0, 2 * width)), np.array([0, 2]), np.zeros((1, 5)))
     return acc[:3]
 
 

@@ -10,7 +10,8 @@ by γ_s h, a velocity difference across one kernel, so that D does not depend on
 [choice]). γ_s is ``numerics.shifting_rate``: the imposed shear rate of a Couette flow by
 default; a flow without one (bodies driven through fluid at rest) names its own scale. Its
 velocity is carried along the local gradient, v_i += δr_i · ∇v_i (Lind's Taylor correction,
-with the step's corrected gradient).
+with the step's corrected gradient; a Newtonian fluid's is up to
+``numerics.normalisation_interval`` − 1 steps old, ``velocity_pass.normalisation_due``).
 Body particles stay rigid; they count in C, so fluid is pushed off dense body shells too.
 
 Why: a disordered SPH fluid under shear builds up an anisotropic particle structure whose
@@ -40,70 +41,26 @@ import math
 from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
-from suspsim.sph.chunks import add_chunk_buffers
 
 #: Largest shift per step [h] (SPEC §5.5: 0.1 h).
 MAX_SHIFT = 0.1
 
 
-@njit(inline="always", **JIT_OPTIONS)
-def _concentration_loop(lo, hi, start, pair_end, pair_j, geometry, volume, acc):
-    """acc[3i + a] += (∇C_i)_a = −Σ_j V_j F r_ij,a for particles lo..hi−1, both ends of each
-    pair (``acc`` flat (3N,))."""
-    for i in range(lo, hi):
-        vol_i = volume[i]
-        gx = gy = gz = 0.0
-        js, rows = pair_j[start[i]:pair_end[i]], geometry[start[i]:pair_end[i]]
-        for k in range(js.shape[0]):
-            j = js[k]
-            row = rows[k]
-            fj = volume[j] * row[3]
-            fi = vol_i * row[3]
-            gx -= fj * row[0]
-            gy -= fj * row[1]
-            gz -= fj * row[2]
-            b = 3 * j
-            acc[b] += fi * row[0]
-            acc[b + 1] += fi * row[1]
-            acc[b + 2] += fi * row[2]
-        b = 3 * i
-        acc[b] += gx
-        acc[b + 1] += gy
-        acc[b + 2] += gz
-
-
 @njit(parallel=True, **JIT_OPTIONS)
-def concentration_gradient(start, pair_end, pair_j, geometry, volume, acc, scratch, bounds):
-    """acc (3N,) = ∇C of every particle over the half pair table, in T = scratch.shape[0] + 1
-    chunks (the pattern of ``density``; ``scratch`` rows of at least 3N entries)."""
-    n_chunks = scratch.shape[0] + 1
-    n3 = acc.shape[0]
-    for c in prange(n_chunks):
-        lo, hi = bounds[c], bounds[c + 1]
-        if c == 0:
-            acc[:] = 0.0
-            _concentration_loop(lo, hi, start, pair_end, pair_j, geometry, volume, acc)
-        else:
-            buffer = scratch[c - 1, :n3]
-            buffer[3 * lo:] = 0.0
-            _concentration_loop(lo, hi, start, pair_end, pair_j, geometry, volume, buffer)
-    add_chunk_buffers(acc, scratch, bounds, n_chunks, 3)
-
-
-@njit(parallel=True, **JIT_OPTIONS)
-def shift_particles(start, pair_end, pair_j, geometry, volume, body_of, coefficient, rate,
-                    dt, h, gradient, grad_c, scratch, bounds, positions, velocities):
-    """Shift every fluid particle (module docstring); ``grad_c`` (3N,) scratch ← ∇C,
-    ``scratch`` and ``bounds`` those of the chunked pair passes; ``gradient`` (N, 9) the
-    step's ∂_k v_l (``terms.gradient``)."""
-    concentration_gradient(start, pair_end, pair_j, geometry, volume, grad_c, scratch, bounds)
+def shift_particles(force_acc, body_of, coefficient, rate, dt, h, gradient, positions,
+                    velocities):
+    """Shift every fluid particle (module docstring) down ∇C, which the step's force pass summed
+    into the last three of each particle's w values of ``force_acc`` (flat (w N,),
+    ``force_pass.force_width``); ``gradient`` (N, 9) the step's ∂_k v_l (``terms.gradient``)."""
+    width = force_acc.shape[0] // positions.shape[0]
     diffusion = coefficient * h * h * abs(rate) * dt
     for i in prange(positions.shape[0]):
         if body_of[i] >= 0:
             continue
-        dx = -diffusion * grad_c[3 * i]
-        dy = -diffusion * grad_c[3 * i + 1]
-        dz = -diffusion * grad_c[3 * i + 2]
+        b = width * (i + 1) - 3
+        dx = -diffusion * force_acc[b]
+        dy = -diffusion * force_acc[b + 1]
+        dz = -diffusion * force_acc[b + 2]
         size = math.sqrt(dx * dx + dy * dy + dz * dz)
         if size > MAX_SHIFT * h:
             scale = MAX_SHIFT * h / size
