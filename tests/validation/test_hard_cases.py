@@ -143,9 +143,11 @@ def test_dense_suspension_runs_or_stops_naming_the_setting(shape, phi, radius, p
                                                            side):
     """Near-contact bodies either keep every health limit for 300 steps or the health check
     fails with a message naming what to change — never NaN unnoticed. Measured at these
-    resolutions (bodies 2–5 lattice spacings across): spheres keep their gaps above s_min with
-    the default repulsion, and both cases stop within 100–200 steps on the fluid's density error
-    (7–27 %, fluid squeezed out of sub-spacing gaps)."""
+    resolutions (bodies 2–5 lattice spacings across): both run the 300 steps with the defaults
+    (the sound speed raised by the crowding factor, ×2.36 at φ = 0.55 and ×1.83 at 0.5, and
+    s_min = 0.05 h). With the fluid's own sound speed and s_min = 0.02 h both stopped within
+    100–200 steps on the fluid's density error (7–27 %, fluid squeezed out of sub-spacing
+    gaps), the spheres' gaps held above s_min by the default repulsion."""
     sim = Simulation(dense_suspension(shape, phi, radius, polydispersity, side), threads=2)
     assert sim.packing_phi == pytest.approx(phi, rel=1e-9)
     for _ in range(3):

@@ -31,13 +31,6 @@ REDUCED = os.environ.get("SUSPSIM_REDUCED") == "1"
 #: The linear polymer's Carreau–Yasuda fit (results/sand/linear_polymer/fit.json; SI units).
 MATRIX = {"mu_0": 2.1054134658718944, "mu_inf": 8.042307660751053e-08,
           "lam": 0.10198992369946352, "a": 0.8640718531766323, "n": 0.2994569788067771}
-#: Settings that run φ = 0.5 (README, sand against spheres at φ = 0.4 and 0.5): a stiffer fluid,
-#: c = 1.4 h/τ (default 0.988; the step becomes the acoustic 0.25 h/(c + γ̇L_y/2) = 0.174 τ
-#: instead of the viscous 0.205 τ), and lubrication and repulsion held from s_min = 0.05 h
-#: (default 0.02 h).
-DENSE = {"run.sound_speed": 1.4, "inclusions.lubrication.min_gap": 0.05}
-
-
 def _shear(sim: Simulation, steps: int) -> tuple[float, float, float]:
     """Advance ``sim`` by ``steps``, asserting its health every 2 steps; (smallest surface gap
     [h], largest fluid density error [1], largest body velocity component relative to the
@@ -71,18 +64,18 @@ def test_sand_at_phi_0_3_keeps_its_gaps():
     assert 0.0 < smallest < 0.1
 
 
-def test_dense_sand_at_phi_0_5_runs_with_the_dense_settings():
+def test_dense_sand_at_phi_0_5_runs_with_the_defaults():
     """37 grains at φ = 0.5 in the Newtonian scene of the sand/spheres comparison
-    (validation.suspension, packing seed 1) with :data:`DENSE`. With the defaults this packing
-    stops at step 792 (density error 0.301 > 0.3) and, with that limit raised to 0.5, at step
-    816 (bodies overlap, gap −0.031 h); halving run.dt only delays it to step 2796; with
-    c = 1.18 h/τ and s_min = 0.05 h it stops at step 5733 (density error 0.316)."""
-    scene = suspension_scene(shape="sand", phi=0.5, radius=2.5, box=16.875, seed=1,
-                             overrides=DENSE)
+    (validation.suspension, packing seed 1), with the defaults: the sound speed raised by the
+    crowding factor (``sph.timestep``: 1.83 × 0.988 h/τ) and lubrication held from s_min =
+    0.05 h. Before them (c = 0.988 h/τ, s_min = 0.02 h) this packing stopped at step 792 (density
+    error 0.301 > 0.3) and, with that limit raised to 0.5, at step 816 (bodies overlap, gap
+    −0.031 h); with the crowding factor alone it overlapped at step 4981 (gap −0.007 h)."""
+    scene = suspension_scene(shape="sand", phi=0.5, radius=2.5, box=16.875, seed=1)
     smallest, density_error, speed = _shear(Simulation(scene, threads=1),
                                             300 if REDUCED else 1000)
-    # measured: smallest gap 0.038 h, density error 0.248, speed 0.67 of the wall's (1000
-    # steps); 0.072 h, 0.248, 0.27 (300 steps)
+    # measured: smallest gap 0.074 h, density error 0.198, speed 0.35 of the wall's (1000
+    # steps); 0.074 h, 0.198, 0.28 (300 steps)
     assert 0.0 < smallest < 0.1
     assert density_error < scene.run.max_density_error
     assert speed < 1.0

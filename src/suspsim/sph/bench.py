@@ -14,7 +14,9 @@ of side k/1.6 h for the scaling with N (``suspsim bench --particles``). Scenes:
 - ``fluid-papanastasiou``: μ_pl = 0.01, μ_0 = 0.99, M = 100 (seed 000: μ_0/μ_pl = 99), γ̇ = 0.01;
 - ``suspension-newtonian``: the Newtonian fluid with spheres of radius 2.5 h at φ = 0.4 (the
   bodies' shell particles count as particles; the start's relaxation is cut to 100 steps, a
-  benchmark measures cost, not physics);
+  benchmark measures cost, not physics; its default sound speed and step are the dense
+  suspension's, ``timestep.crowding_factor``, so per unit strain it takes 1.3 × the fluid's
+  steps);
 - ``suspension-papanastasiou``: the Papanastasiou fluid with the same spheres (adds the
   shear-rate pass and its smoothing, ``terms.rate_smoothing``);
 - ``dst-2d``: the 2D Wyart–Cates solver between walls (:mod:`suspsim.dst.bench`; a different

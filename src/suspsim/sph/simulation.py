@@ -140,7 +140,7 @@ class Simulation:
         self._smooth_rate = bool(scene.numerics.rate_smoothing)
         if _state is None:
             self.sound_speed = (float(scene.run.sound_speed) if scene.run.sound_speed is not None
-                                else auto_sound_speed(scene))
+                                else auto_sound_speed(scene, self.packing_phi))
             self.dt = (float(scene.run.dt) if scene.run.dt is not None
                        else stable_time_step(scene, self.sound_speed))
             self.step_count = 0

@@ -7,9 +7,14 @@ criterion,
 
 with Wi = ``numerics.wi_target`` (1e−3: the probe found the Morris minimum leaves ≈ +4 % stress
 through the pressure and 1e−4 turns the lattice plastic), σ_s the stress scale and v_s the
-velocity scale relative to the imposed flow: Couette σ_s = μ(γ̇) γ̇, v_s = γ̇ L_y/2 from rest
-(the initial jump across the sheared faces) or γ̇ h from the linear profile (the velocity
-difference across a neighbourhood); Poiseuille σ_s = ρ g L_y/4 (the wall stress of each half)
+velocity scale relative to the imposed flow. A dense suspension squeezes fluid through gaps
+between bodies whose width falls with φ, and the stress there grows as a/ḡ (ḡ the mean surface
+gap): above :data:`CROWDING_REFERENCE_PHI` the viscous criterion takes the factor
+:func:`crowding_factor` = sqrt(ḡ(φ_ref)/ḡ(φ)), ḡ/a = (φ_m/φ)^(1/3) − 1 with φ_m =
+:data:`CLOSE_PACKING` [choice: keeps the fluid's density error in the gaps at its level at
+φ_ref, where the defaults ran every packing]. The scales: Couette σ_s = μ(γ̇) γ̇,
+v_s = γ̇ L_y/2 from rest (the initial jump across the sheared faces) or γ̇ h from the linear
+profile (the velocity difference across a neighbourhood); Poiseuille σ_s = ρ g L_y/4 (the wall stress of each half)
 and v_s the reference centre-line velocity (``reference.poiseuille``).
 
 Time step [SPEC §2.6; coefficients measured by ``tests/unit/sph/test_simulation.py``]:
@@ -36,6 +41,11 @@ from suspsim.scene import Scene
 
 #: Target Mach number of the velocity scale (Morris et al. 1997) [choice].
 MACH_TARGET = 0.1
+#: φ above which the sound speed grows with the crowding of the bodies [choice: the densest φ
+#: at which every packing of the dense-suspension and sand studies ran with the fluid's c].
+CROWDING_REFERENCE_PHI = 0.3
+#: Random close packing of monodisperse spheres, φ_m of the mean gap (Torquato et al. 2000).
+CLOSE_PACKING = 0.64
 #: C_c in δt ≤ C_c h/(c + v_s) for the Lucy kernel (support h), measured stable.
 ACOUSTIC_COEFFICIENT = 0.25
 #: C_a in δt ≤ C_a sqrt(h/g) (Morris et al. 1997) [choice].
@@ -69,10 +79,28 @@ def _centre_velocity(law: str, params: tuple, force_density: float, half: float)
     return float(poiseuille_profile(make_law(law, dict(params)), force_density, half, 0.5 * half))
 
 
-def auto_sound_speed(scene: Scene) -> float:
-    """c = max(sqrt(σ_s/(ρ Wi)), v_s/MACH_TARGET) (module docstring)."""
+def mean_gap(phi: float) -> float:
+    """ḡ/a = (φ_m/φ)^(1/3) − 1 [1]: the mean surface gap of bodies of radius a at volume
+    fraction φ, their spacing scaled from close packing φ_m = :data:`CLOSE_PACKING` (floored
+    at 0.01 so that φ near φ_m stays finite)."""
+    return max((CLOSE_PACKING / phi) ** (1.0 / 3.0) - 1.0, 0.01)
+
+
+def crowding_factor(phi: float) -> float:
+    """sqrt(ḡ(φ_ref)/ḡ(φ)) above φ_ref = :data:`CROWDING_REFERENCE_PHI`, else 1 [1]: the
+    sound speed's factor for the gap stress of a dense suspension (module docstring)."""
+    if phi <= CROWDING_REFERENCE_PHI:
+        return 1.0
+    return math.sqrt(mean_gap(CROWDING_REFERENCE_PHI) / mean_gap(phi))
+
+
+def auto_sound_speed(scene: Scene, phi: float | None = None) -> float:
+    """c = max(sqrt(σ_s/(ρ Wi)) f(φ), v_s/MACH_TARGET) (module docstring), f the
+    :func:`crowding_factor` of the bodies' volume fraction ``phi`` [1] (default: the scene's
+    ``inclusions.phi``; a packing file's own φ is known only once it is read)."""
     viscous = math.sqrt(stress_scale(scene) / (scene.density * scene.numerics.wi_target))
-    return max(viscous, velocity_scale(scene) / MACH_TARGET)
+    phi = scene.inclusions.phi if phi is None else phi
+    return max(viscous * crowding_factor(phi), velocity_scale(scene) / MACH_TARGET)
 
 
 def max_viscosity(scene: Scene) -> float:
