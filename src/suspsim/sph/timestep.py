@@ -3,19 +3,20 @@
 Sound speed [choice, SPEC §2.2 and the probe]: the larger of the viscous criterion and the Mach
 criterion,
 
-    c = max( sqrt(σ_s/(ρ Wi)), v_s/MACH_TARGET ),
+    c = max( sqrt(σ_s/(ρ Wi)) f(φ), v_s/MACH_TARGET ),
 
 with Wi = ``numerics.wi_target`` (1e−3: the probe found the Morris minimum leaves ≈ +4 % stress
 through the pressure and 1e−4 turns the lattice plastic), σ_s the stress scale and v_s the
-velocity scale relative to the imposed flow. A dense suspension squeezes fluid through gaps
-between bodies whose width falls with φ, and the stress there grows as a/ḡ (ḡ the mean surface
-gap): above :data:`CROWDING_REFERENCE_PHI` the viscous criterion takes the factor
-:func:`crowding_factor` = sqrt(ḡ(φ_ref)/ḡ(φ)), ḡ/a = (φ_m/φ)^(1/3) − 1 with φ_m =
-:data:`CLOSE_PACKING` [choice: keeps the fluid's density error in the gaps at its level at
-φ_ref, where the defaults ran every packing]. The scales: Couette σ_s = μ(γ̇) γ̇,
-v_s = γ̇ L_y/2 from rest (the initial jump across the sheared faces) or γ̇ h from the linear
-profile (the velocity difference across a neighbourhood); Poiseuille σ_s = ρ g L_y/4 (the wall stress of each half)
-and v_s the reference centre-line velocity (``reference.poiseuille``).
+velocity scale relative to the imposed flow, and f(φ) the crowding of rigid bodies at volume
+fraction φ (1 without). A dense suspension squeezes fluid through gaps whose width falls with
+φ, and the stress there grows as a/ḡ (ḡ the mean surface gap): above
+:data:`CROWDING_REFERENCE_PHI`, f = :func:`crowding_factor` = sqrt(ḡ(φ_ref)/ḡ(φ)),
+ḡ/a = (φ_m/φ)^(1/3) − 1 with φ_m = :data:`CLOSE_PACKING` [choice: meant to hold the fluid's
+density error in the gaps near its level at φ_ref, where the fluid's own c ran every packing;
+measured 0.15–0.28 at φ = 0.4–0.5, README]. The scales: Couette σ_s = μ(γ̇) γ̇, v_s = γ̇ L_y/2
+from rest (the initial jump across the sheared faces) or γ̇ h from the linear profile (the
+velocity difference across a neighbourhood); Poiseuille σ_s = ρ g L_y/4 (the wall stress of
+each half) and v_s the reference centre-line velocity (``reference.poiseuille``).
 
 Time step [SPEC §2.6; coefficients measured by ``tests/unit/sph/test_simulation.py``]:
 
