@@ -1,20 +1,25 @@
 """The compiled-code cache follows the sources (``suspsim.jit_cache``): any edit to any source
 file gives a new folder, the user's NUMBA_CACHE_DIR stands, and old folders are pruned."""
 import os
-from pathlib import Path
+import subprocess
+import sys
 
 import numba
-import pytest
 
 from suspsim import jit_cache
 
 
-def test_the_running_package_caches_in_the_folder_of_its_sources():
-    folder = Path(os.environ["NUMBA_CACHE_DIR"])
-    if folder.name != jit_cache.source_hash():
-        pytest.skip("NUMBA_CACHE_DIR was set before suspsim was imported: the user's folder")
-    assert folder.parent == jit_cache.cache_root() and folder.is_dir()
-    assert numba.config.CACHE_DIR == str(folder)
+def test_importing_suspsim_points_numba_at_the_folder_of_its_sources(tmp_path):
+    """In a fresh interpreter without NUMBA_CACHE_DIR: the variable and numba's own setting
+    name <XDG_CACHE_HOME>/suspsim/numba/<source hash>, and the folder exists."""
+    env = {key: value for key, value in os.environ.items() if key != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path)
+    shown = subprocess.run(
+        [sys.executable, "-c", "import os, suspsim, numba; "
+         "print(os.environ['NUMBA_CACHE_DIR']); print(numba.config.CACHE_DIR)"],
+        env=env, capture_output=True, text=True, check=True).stdout.split()
+    folder = tmp_path / "suspsim" / "numba" / jit_cache.source_hash()
+    assert shown == [str(folder), str(folder)] and folder.is_dir()
 
 
 def test_the_hash_changes_with_any_file_and_only_with_the_sources(tmp_path):

@@ -22,8 +22,8 @@ With particle shifting (``terms.shifting``) the pass also sums the particle conc
 gradient ∇C_i = −Σ_j V_j F r_ij over the same pairs, so shifting needs no pass of its own (its
 positions and volumes are the force pass's: shifting acts after the kick, before the next
 drift). A pass of its own cost 0.55 ms per step; these sums add 0.15 ms in a Newtonian matrix
-and 0.35 ms beside the bulk gradient's sums (φ = 0.4 benchmark suspensions, two threads). Pairs inside one body are skipped here, which changes ∇C only on body
-particles, which do not shift.
+and 0.35 ms beside the bulk gradient's sums (φ = 0.4 benchmark suspensions, two threads). Pairs
+inside one body are skipped here, which changes ∇C only on body particles, which do not shift.
 
 The accumulator holds per particle the force (3), then the ∇a sums (3) with the bulk
 gradient, then ∇C (3) with shifting (:func:`force_width`): the plain fluid scatters 3 values
