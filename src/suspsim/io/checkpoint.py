@@ -29,7 +29,8 @@ from .atomic import atomic_path
 log = logging.getLogger(__name__)
 
 FORMAT = "suspsim-checkpoint"
-FORMAT_VERSION = 1
+#: 2: body particles take μ̂ from the fluid beside them, held in the state (``body_viscosity``).
+FORMAT_VERSION = 2
 #: Scene keys that do not change the physics and may differ when a run resumes.
 RESUMABLE_KEYS = (("run", "threads"), ("run", "checkpoint_interval_s"),
                   ("run", "max_density_error"), ("run", "max_mach"),

@@ -36,7 +36,7 @@ import numpy as np
 from suspsim.dst.bench import SCENE as DST_SCENE
 from suspsim.dst.bench import benchmark_dst
 from suspsim.scene import scene_from_dict
-from suspsim.sph.density import mass_density, summation_density
+from suspsim.sph.density import body_particle_density, mass_density, summation_density
 from suspsim.sph.simulation import SUPPORT, Simulation
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
@@ -143,9 +143,10 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     """Best-of-``repeats`` wall time [s] of each compiled pass of one step on ``sim``'s state.
 
     The passes run in step order on the current positions and velocities (the state is
-    recomputed, not advanced): density (with the pair table), gradient sums and finish,
-    dissipation sums and normalisation finish (when the scene normalises), force sums and
-    finish. Their sum is the step without drift, kick and rebuilds.
+    recomputed, not advanced): density (with the pair table), body density (with bodies),
+    gradient sums and finish, dissipation sums and normalisation finish (when the scene
+    normalises), force sums and finish. Their sum is the step without drift, kick, rebuilds
+    and the bodies' own work.
     """
     use_threads(sim.threads)
     box, tb, nl = sim._box, sim._table, sim._nlist
@@ -157,6 +158,13 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
                           tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
                           sim._scratch_1, sim._bounds),
         mass_density(sim._rho, sim._mass, sim._volume))}
+    if sim.bodies is not None:
+        n = sim.n_particles
+        calls["body density"] = lambda: body_particle_density(
+            tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._body_of, sim._kernel,
+            SUPPORT, sim._rho, sim._rho_eq, sim.sound_speed ** 2, sim._mass, sim._mu_hat,
+            sim._grad_acc[:3 * n], sim._scratch_15[:, :3 * n], sim._bounds, sim._volume,
+            sim._body_mu)
     if sim._velocity_gradient:
         calls["gradient sums"] = lambda: _gradient_sums(
             tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
@@ -164,8 +172,8 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
             sim._bounds)
         calls["gradient finish"] = lambda: _gradient_finish(
             sim._grad_acc, sim.scene.dimension, law.code, law.packed, sim._newtonian,
-            sim._normalise, sim._beta, sim._gradient, sim._inverse_moment, sim._moment_trace,
-            sim._gdot, sim._mu, sim._strain, sim._dissipation)
+            sim._normalise, sim._beta, sim._body_of, sim._gradient, sim._inverse_moment,
+            sim._moment_trace, sim._gdot, sim._mu, sim._strain, sim._dissipation)
     if sim._normalise:
         if sim._alpha != 0.0:
             calls["dissipation sums"] = lambda: _dissipation_sums(

@@ -309,12 +309,13 @@ def summation_density(positions, box, offset, start, image_start, neighbours, ke
 
 @njit(inline="always", **JIT_OPTIONS)
 def _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho, rho_eq,
-                  c2, acc):
-    """acc[2 j] += W, acc[2 j + 1] += W P_f over the fluid–body pairs of particles lo..hi−1,
-    for the body particle j of each pair (either end)."""
+                  c2, viscosity_hat, acc):
+    """acc[3 j] += W, acc[3 j + 1] += W P_f, acc[3 j + 2] += W μ̂_f over the fluid–body pairs of
+    particles lo..hi−1, for the body particle j of each pair (either end)."""
     for i in range(lo, hi):
         body_i = body_of[i]
         p_i = c2 * (rho[i] - rho_eq)
+        mu_i = viscosity_hat[i]
         for k in range(pair_start[i], pair_end[i]):
             j = pair_j[k]
             if (body_i < 0) == (body_of[j] < 0):
@@ -323,17 +324,19 @@ def _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kerne
             w = kernel_w(kernel, math.sqrt(row[DX] * row[DX] + row[DY] * row[DY]
                                            + row[DZ] * row[DZ]), h)
             if body_i >= 0:
-                acc[2 * i] += w
-                acc[2 * i + 1] += w * c2 * (rho[j] - rho_eq)
+                acc[3 * i] += w
+                acc[3 * i + 1] += w * c2 * (rho[j] - rho_eq)
+                acc[3 * i + 2] += w * viscosity_hat[j]
             else:
-                acc[2 * j] += w
-                acc[2 * j + 1] += w * p_i
+                acc[3 * j] += w
+                acc[3 * j + 1] += w * p_i
+                acc[3 * j + 2] += w * mu_i
 
 
 @njit(parallel=True, **JIT_OPTIONS)
 def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho, rho_eq,
-                          c2, mass, acc, scratch, bounds, volume):
-    """Density of rigid-body particles from the pressure of the fluid around them.
+                          c2, mass, viscosity_hat, acc, scratch, bounds, volume, body_viscosity):
+    """Density and viscosity of rigid-body particles from the fluid around them.
 
     A body particle j takes the Shepard average of its fluid neighbours' pressures,
     P_j = Σ_f P_f W_jf / Σ_f W_jf with P_f = c² (ρ_f − ρ_eq) (Adami, Hu & Adams 2012, Eq. 27,
@@ -341,9 +344,21 @@ def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kerne
     ρ_j = ρ_eq + P_j/c², V_j = m/ρ_j. Its own summation density would instead reflect how the
     body's lattice meets the fluid's (shell particles sit 5–10 % below ρ_eq after the start's
     relaxation, a tension that pulls fluid onto the surface and kept the relaxation from
-    converging). A body particle without fluid neighbours gets ρ_eq. One sweep of the pair
-    table in the chunks of the density pass (``bounds``; pattern of ``chunks``): ``acc``
-    (2N,) holds (Σ W, Σ W P_f) per particle, ``scratch`` (T − 1, ≥ 2N) the other chunks'.
+    converging). A body particle without fluid neighbours gets ρ_eq.
+
+    Likewise ``body_viscosity`` μ̂_j = Σ_f μ̂_f W_jf / Σ_f W_jf [choice], the normalised
+    viscosity of the fluid beside it, which a pair of particles of two different bodies uses
+    (a fluid–body pair takes the fluid's μ̂ at both ends, ``force_pass``). μ̂_f is the previous
+    step's (this step's is computed later from the volumes set here); a body particle without
+    fluid neighbours keeps its value. Pairs inside one body have no force (the body moves
+    rigidly) and, with density and μ̂ taken from the fluid, no other use, so the list leaves
+    them out (``group`` of ``neighbours.build_neighbour_list``; a fifth of the pairs within h
+    at φ = 0.4). A body particle's own rate and dissipation factor then come from a one-sided
+    neighbourhood, and the shell's inner particles have no neighbours at all.
+
+    One sweep of the pair table in the chunks of the density pass (``bounds``; pattern of
+    ``chunks``): ``acc`` (3N,) holds (Σ W, Σ W P_f, Σ W μ̂_f) per particle, ``scratch``
+    (T − 1, ≥ 3N) the other chunks'.
     """
     n_chunks = scratch.shape[0] + 1
     for c in prange(n_chunks):
@@ -351,16 +366,27 @@ def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kerne
         if c == 0:
             acc[:] = 0.0
             _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kernel, h,
-                          rho, rho_eq, c2, acc)
+                          rho, rho_eq, c2, viscosity_hat, acc)
         else:
             buffer = scratch[c - 1]
-            buffer[2 * lo:] = 0.0
+            buffer[3 * lo:] = 0.0
             _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kernel, h,
-                          rho, rho_eq, c2, buffer)
-    add_chunk_buffers(acc, scratch, bounds, n_chunks, 2)
+                          rho, rho_eq, c2, viscosity_hat, buffer)
+    add_chunk_buffers(acc, scratch, bounds, n_chunks, 3)
     for i in prange(rho.shape[0]):
         if body_of[i] >= 0:
-            weight = acc[2 * i]
-            p = acc[2 * i + 1] / weight if weight > 0.0 else 0.0
+            weight = acc[3 * i]
+            p = acc[3 * i + 1] / weight if weight > 0.0 else 0.0
             rho[i] = rho_eq + p / c2
             volume[i] = mass / rho[i]
+            if weight > 0.0:
+                body_viscosity[i] = acc[3 * i + 2] / weight
+
+
+@njit(parallel=True, **JIT_OPTIONS)
+def set_body_viscosity(body_of, body_viscosity, viscosity_hat):
+    """μ̂_i = ``body_viscosity``[i] for every body particle i (after the normalisation, which
+    computes a meaningless μ̂ from a body particle's one-sided neighbourhood)."""
+    for i in prange(body_of.shape[0]):
+        if body_of[i] >= 0:
+            viscosity_hat[i] = body_viscosity[i]

@@ -206,7 +206,7 @@ def _listed(i, j, half):
 
 @njit(cache=True, parallel=True)
 def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start, neighbours,
-           half, share_lo, used, buf_x, buf_y, buf_z, buf_j, buf_d):
+           half, group, share_lo, used, buf_x, buf_y, buf_z, buf_j, buf_d):
     """List the pairs of each block of cells into its share [share_lo[b], share_lo[b+1]).
 
     Each block copies a cell's stencil into a contiguous candidate buffer once and tests it
@@ -217,11 +217,14 @@ def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start
     32,768-particle benchmark box). Where a particle's candidates might not fit the share, the
     compaction checks each slot. ``used[b]`` counts the block's pairs even beyond its share
     (those are not written). Variables of the prange body are not reused after it: numba
-    would treat them as reductions.
+    would treat them as reductions. A particle of a group (``group[i]`` ≥ 0; ``group`` empty:
+    no groups) drops the candidates of its own group in a compaction of its own, so that the
+    others pay nothing for the test.
     """
     n_cells = cell_start.shape[0] - 1
     n_blocks = used.shape[0]
     rc2 = cutoff * cutoff
+    grouped = group.shape[0] > 0
     for b in prange(n_blocks):
         bx, by, bz, bj, bd = buf_x[b], buf_y[b], buf_z[b], buf_j[b], buf_d[b]
         slot = share_lo[b]
@@ -239,7 +242,18 @@ def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start
                     dz = zi - bz[k]
                     bd[k] = dx * dx + dy * dy + dz * dz
                 start[i] = slot
-                if slot + n_cand <= slot_end:
+                g = group[i] if grouped else -1
+                if g >= 0 and slot + n_cand <= slot_end:
+                    for k in range(n_plain):
+                        j = bj[k]
+                        neighbours[slot] = j
+                        slot += (bd[k] < rc2) & _listed(i, j, half) & (group[j] != g)
+                    image_start[i] = slot
+                    for k in range(n_plain, n_cand):
+                        j = bj[k]
+                        neighbours[slot] = j
+                        slot += (bd[k] < rc2) & _listed(i, j, half) & (group[j] != g)
+                elif slot + n_cand <= slot_end:
                     for k in range(n_plain):
                         j = bj[k]
                         neighbours[slot] = j
@@ -256,7 +270,7 @@ def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start
                         j = bj[k]
                         if slot < slot_end:
                             neighbours[slot] = j
-                        slot += (bd[k] < rc2) & _listed(i, j, half)
+                        slot += (bd[k] < rc2) & _listed(i, j, half) & (g < 0 or group[j] != g)
                     if n_plain == n_cand:
                         image_start[i] = slot
         used[b] = slot - share_lo[b]
@@ -264,13 +278,16 @@ def _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start
 
 @njit(cache=True)
 def build_neighbour_list(positions, box, offset, cutoff, cells, cell_start, start, image_start,
-                         neighbours, half=True, n_blocks=16):
+                         neighbours, half=True, n_blocks=16, group=None):
     """CSR neighbour list of wrapped, cell-sorted positions; returns (code, n_pairs).
 
-    half=True lists each pair once (j > i), half=False both directions. Particle i's
-    neighbours are ``neighbours[start[i]:start[i+1]]``: first those whose pair vector needs no
-    image shift, from ``image_start[i]`` on those that need the minimum image. That split stays
-    valid until the next build because positions are not wrapped in between.
+    half=True lists each pair once (j > i), half=False both directions. ``group`` (N,) int64,
+    optional: pairs of two particles of one group (``group[i] == group[j] ≥ 0``) are not
+    listed; the simulation's groups are its rigid bodies, whose inner pairs have no use
+    (``density.body_particle_density``). Particle i's neighbours are
+    ``neighbours[start[i]:start[i+1]]``: first those whose pair vector needs no image shift,
+    from ``image_start[i]`` on those that need the minimum image. That split stays valid until
+    the next build because positions are not wrapped in between.
 
     One parallel sweep over ``n_blocks`` blocks of cells, each writing into a share of
     ``neighbours`` proportional to its particle count; the shares are then compacted. If a
@@ -297,9 +314,10 @@ def build_neighbour_list(positions, box, offset, cutoff, cells, cell_start, star
     buf_z = np.empty((n_blocks, size))
     buf_j = np.empty((n_blocks, size), dtype=np.int32)
     buf_d = np.empty((n_blocks, size))
+    groups = np.empty(0, dtype=np.int64) if group is None else group
     for attempt in range(2):
         _sweep(positions, box, offset, cutoff, cells, cell_start, start, image_start, neighbours,
-               half, share_lo, used, buf_x, buf_y, buf_z, buf_j, buf_d)
+               half, groups, share_lo, used, buf_x, buf_y, buf_z, buf_j, buf_d)
         total = used.sum()
         if total > capacity:
             return PAIR_OVERFLOW, total
@@ -410,11 +428,13 @@ def raise_for_code(code: int, n_pairs: int, capacity: int) -> None:
 
 
 def rebuild_neighbour_list(nlist: NeighbourList, positions, velocities, box, offset: float,
-                           shear_rate: float, particle_arrays=()) -> None:
+                           shear_rate: float, particle_arrays=(), group=None) -> None:
     """Wrap, sort and list in place: the Python driver of the life cycle's step 1.
 
     ``positions``, ``velocities`` (N, 3) and every array in ``particle_arrays`` (first axis N)
-    are wrapped/permuted in place into cell order. Raises :class:`NeighbourListOverflowError`.
+    are wrapped/permuted in place into cell order; ``group`` (N,) int64, if given, must be one
+    of them (pairs inside a group are not listed, :func:`build_neighbour_list`). Raises
+    :class:`NeighbourListOverflowError`.
     """
     box = np.asarray(box, dtype=np.float64)
     wrap_particles(positions, velocities, box, offset, shear_rate)
@@ -424,7 +444,7 @@ def rebuild_neighbour_list(nlist: NeighbourList, positions, velocities, box, off
         apply_permutation(source, nlist.order, array)
     code, n_pairs = build_neighbour_list(positions, box, offset, nlist.cutoff, nlist.cells,
                                          nlist.cell_start, nlist.start, nlist.image_start,
-                                         nlist.neighbours, nlist.half)
+                                         nlist.neighbours, nlist.half, group=group)
     raise_for_code(code, n_pairs, nlist.neighbours.shape[0])
     nlist.n_pairs = int(n_pairs)
     nlist.reference[:] = positions

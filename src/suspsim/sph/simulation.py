@@ -72,7 +72,7 @@ _STATE_ARRAYS = {"positions": "_x", "velocities": "_v", "accelerations": "_a",
                  "normalisation_factor": "_factor", "viscosity_hat": "_mu_hat",
                  "velocity_gradient": "_gradient", "inverse_moment": "_inverse_moment",
                  "virial": "_virial", "reference": "_reference", "body_of": "_body_of",
-                 "body_offsets": "_offsets"}
+                 "body_offsets": "_offsets", "body_viscosity": "_body_mu"}
 
 
 class Simulation:
@@ -217,6 +217,10 @@ class Simulation:
         self._virial = np.zeros((t, 5))
         self._body_of = np.full(n, -1, dtype=np.int64)
         self._offsets = np.zeros((n if self.bodies is not None else 0, 3))
+        # μ̂ of body particles from the fluid beside them (``density.body_particle_density``);
+        # one without fluid neighbours keeps its value, so it starts at the imposed rate's μ.
+        self._body_mu = np.full(n if self.bodies is not None else 0,
+                                float(self.scene.fluid.law.viscosity(self._rate)))
         self._members = np.zeros(0, dtype=np.int64)
         self._body_virial = np.zeros(5)
         self._lubrication_virial = np.zeros(5)
@@ -257,9 +261,11 @@ class Simulation:
         return float(lees_edwards_offset(self._rate, self._box[0], self._box[1], time))
 
     def _permuted_arrays(self) -> tuple:
-        """Particle arrays a rebuild reorders besides x and v (body offsets only with bodies:
-        without them ``_offsets`` is empty)."""
-        return (self._a, self._body_of) + ((self._offsets,) if self.bodies is not None else ())
+        """Particle arrays a rebuild reorders besides x and v. With bodies also their offsets,
+        μ̂ (the next step's body particles average the fluid's, ``density.body_particle_density``,
+        before the fluid's own is recomputed) and the body particles' μ̂."""
+        return (self._a, self._body_of) + ((self._offsets, self._mu_hat, self._body_mu)
+                                           if self.bodies is not None else ())
 
     def _rebuild(self, time: float) -> None:
         """Wrap, sort and list at ``time``; grows the list once per overflow."""
@@ -268,7 +274,8 @@ class Simulation:
             try:
                 rebuild_neighbour_list(self._nlist, self._x, self._v, self._box,
                                        self._offset(time), self._rate,
-                                       particle_arrays=self._permuted_arrays())
+                                       particle_arrays=self._permuted_arrays(),
+                                       group=self._body_of if self.bodies is not None else None)
                 break
             except NeighbourListOverflowError as err:
                 factor = 1.3 * err.required / err.capacity * self._capacity_factor
@@ -291,7 +298,9 @@ class Simulation:
             raise ValueError("state: the reference positions are not in cell order")
         code, n_pairs = build_neighbour_list(self._reference, box, self._offset(self._build_time),
                                              nl.cutoff, nl.cells, nl.cell_start, nl.start,
-                                             nl.image_start, nl.neighbours, True)
+                                             nl.image_start, nl.neighbours, True,
+                                             group=self._body_of if self.bodies is not None
+                                             else None)
         raise_for_code(code, n_pairs, nl.neighbours.shape[0])
         nl.n_pairs = int(n_pairs)
 
@@ -308,7 +317,7 @@ class Simulation:
                 self._pressure, tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry,
                 tb.pair_cross, tb.pair_image, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
-                self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
+                self._gdot, self._mu, self._factor, self._mu_hat, self._body_mu, self._grad_acc,
                 self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,
                 self._force_scratch, self._bounds, self._virial)
 

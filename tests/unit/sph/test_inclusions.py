@@ -3,15 +3,16 @@ import numpy as np
 import pytest
 
 from suspsim.scene import scene_from_dict
+from suspsim.sph.kernels import lucy_w_3d
 from suspsim.sph.simulation import Simulation
 
 RATE = 0.004
 
 
-def suspension_scene(phi=0.1, side=7.5, radius=1.5, **numerics):
+def suspension_scene(phi=0.1, side=7.5, radius=1.5, fluid=None, **numerics):
     return scene_from_dict({
         "dimension": 3, "box": [side] * 3, "number_density": 4.096,
-        "fluid": {"law": "newtonian", "params": {"mu": 1.0}},
+        "fluid": fluid or {"law": "newtonian", "params": {"mu": 1.0}},
         "flow": {"type": "couette", "shear_rate": RATE},
         "run": {"strain": 1.0, "start": "linear", "max_density_error": 0.2},
         "lattice": {"relax_max_steps": 200},
@@ -150,3 +151,50 @@ def test_sand_resume_continues_bit_for_bit_with_grain_lubrication():
     np.testing.assert_array_equal(resumed.bodies.centres, straight.bodies.centres)
     np.testing.assert_array_equal(resumed.bodies.momenta, straight.bodies.momenta)
     np.testing.assert_array_equal(resumed._lubrication_virial, straight._lubrication_virial)
+
+
+def test_body_particles_take_the_viscosity_of_the_fluid_beside_them():
+    """No pair inside one body is listed; after a step every body particle with fluid within
+    h carries the Shepard average Σ_f W μ̂_f / Σ_f W of the fluid's μ̂ of the step before
+    (brute force over the fluid's nearest images; the pair table holds r in float32, hence the
+    relative 10⁻⁷), its gradient and rate are 0, and nothing is
+    NaN. A power-law matrix, so that the fluid's μ̂ varies from particle to particle; no
+    shifting, which would move the fluid after the force pass."""
+    sc = suspension_scene(fluid={"law": "power_law", "params": {"K": RATE ** 0.5, "n": 0.5}},
+                          shifting=0)
+    sim = Simulation(sc, threads=1)
+    sim.advance(3)
+    nl = sim._nlist
+    i = np.repeat(np.arange(sim.n_particles), np.diff(nl.start))
+    j = nl.neighbours[:nl.start[-1]].astype(np.int64)
+    assert not np.any((sim._body_of[i] >= 0) & (sim._body_of[i] == sim._body_of[j]))
+    for _ in range(20):  # a step without a rebuild, which would reorder the particles
+        previous, builds = sim._mu_hat.copy(), sim.rebuild_count
+        sim.advance(1)
+        if sim.rebuild_count == builds:
+            break
+    for name in ("_mu_hat", "_mu", "_gdot", "_gradient", "_inverse_moment", "_a"):
+        assert np.all(np.isfinite(getattr(sim, name))), name
+    members = sim._members
+    np.testing.assert_array_equal(sim._gradient[members], 0.0)
+    np.testing.assert_array_equal(sim._gdot[members], 0.0)
+    fluid = np.flatnonzero(sim._body_of < 0)
+    box = np.asarray(sim.scene.box)
+    offset = sim._offset(sim.time)
+    checked = 0
+    for m in members[::7]:
+        d = sim._x[m] - sim._x[fluid]
+        n = np.rint(d[:, 1] / box[1])
+        d[:, 1] -= n * box[1]
+        d[:, 0] -= n * offset
+        d[:, 0] -= box[0] * np.rint(d[:, 0] / box[0])
+        d[:, 2] -= box[2] * np.rint(d[:, 2] / box[2])
+        r = np.linalg.norm(d, axis=1)
+        near = r < 1.0
+        if not near.any():
+            continue
+        w = np.array([lucy_w_3d(x, 1.0) for x in r[near]])
+        assert sim._mu_hat[m] == pytest.approx(np.sum(w * previous[fluid][near]) / w.sum(),
+                                               rel=1e-7)
+        checked += 1
+    assert checked > 10

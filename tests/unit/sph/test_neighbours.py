@@ -97,6 +97,34 @@ def test_list_equals_brute_force(dim, kind, box_index, offset_fraction):
         np.testing.assert_array_equal(plain, k < nlist.image_start[i])
 
 
+@pytest.mark.parametrize("offset_fraction", [0.0, 0.37, 1.5])
+def test_pairs_inside_one_group_are_not_listed(offset_fraction):
+    """With ``group`` (rigid bodies), the list is the brute-force one minus the pairs of two
+    particles of one group; ungrouped particles (−1) keep every pair, including those with
+    each other, and the plain/image split still holds. A small share of every particle's
+    candidates forces the checked compaction for some particles (capacity 1.05 pairs)."""
+    rng = np.random.default_rng(5)
+    box, positions = scene("random", BOXES[3][1], 3, rng)
+    group = rng.integers(-1, 4, len(positions)).astype(np.int64)
+    offset = offset_fraction * box[0] / 3.0
+    for capacity in (None, 1.05):
+        p, g = positions.copy(), group.copy()
+        nlist = nb.allocate_neighbour_list(len(p), box, CUTOFF, 0.0, 3, len(p) / np.prod(box))
+        if capacity is not None:
+            nlist.neighbours = np.zeros(int(capacity * len(brute_force_pairs(
+                p, box, offset, CUTOFF, 3))), dtype=nlist.neighbours.dtype)
+        nb.rebuild_neighbour_list(nlist, p, np.zeros_like(p), box, offset, 0.0, (g,), group=g)
+        pairs = listed(nlist)
+        expected = {(i, j) for i, j in brute_force_pairs(p, box, offset, CUTOFF, 3)
+                    if g[i] < 0 or g[i] != g[j]}
+        assert len(pairs) == len(set(pairs)) == nlist.n_pairs
+        assert set(pairs) == expected
+        assert any(g[i] < 0 and g[j] < 0 for i, j in pairs)
+        i, j, k = listed_arrays(nlist)
+        plain = np.linalg.norm(p[i] - p[j], axis=1) < CUTOFF
+        np.testing.assert_array_equal(plain, k < nlist.image_start[i])
+
+
 def test_sort_and_permutation():
     rng = np.random.default_rng(2)
     box = np.array([4.0, 5.0, 3.0])

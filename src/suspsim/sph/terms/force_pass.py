@@ -10,9 +10,13 @@ Lees–Edwards correction v_x −= n γ̇ L_y):
 with m² F/(ρ_i ρ_j) = F V_i V_j from the step's volumes V = m/ρ, added to i and subtracted from j (antisymmetric: momentum conserved to round-off).
 A fluid–body pair takes the fluid particle's μ̂ at both ends: a body particle has no viscosity
 of its own, and the rate of its one-sided neighbourhood is meaningless (in a power-law matrix,
-n = 0.5, its μ̂ read 2 × the fluid's, which stiffened every fluid–body pair by a third).
-Pairs of two particles of one rigid body (``body_of[i] == body_of[j] ≥ 0``) are skipped: their
-forces are internal to the body, and the β term of a rotating body would give a spurious torque. With the
+n = 0.5, its μ̂ read 2 × the fluid's, which stiffened every fluid–body pair by a third). A pair
+of particles of two bodies takes at each end the μ̂ of the fluid beside that particle
+(``density.body_particle_density``). Pairs of two particles of one rigid body
+(``body_of[i] == body_of[j] ≥ 0``) have no force: they are internal to the body, and the β
+term of a rotating body would give a spurious torque. The simulation's list does not hold
+them (``group`` of ``neighbours.build_neighbour_list``); the loop also skips them, for tables
+built without groups. With the
 bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
 ∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
 explicit term ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k is added per particle afterwards; it has no pair
