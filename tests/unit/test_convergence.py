@@ -68,11 +68,11 @@ def test_failed_run_is_kept_as_a_failure():
         def execute(self, settings, threads):
             raise self.error
 
-    for error in (NumericalError("density out of bounds"), ValueError("negative bin")):
-        record = run_or_failure(Failing(error), {"width": 2.5})
-        assert record["width"] == 2.5 and type(error).__name__ in record["failure"]
-    with pytest.raises(TypeError):
-        run_or_failure(Failing(TypeError("a bug is not a blow-up")), {})
+    record = run_or_failure(Failing(NumericalError("density out of bounds")), {"width": 2.5})
+    assert record["width"] == 2.5 and "NumericalError" in record["failure"]
+    for error in (TypeError("a bug is not a blow-up"), ValueError("nor is a bad value")):
+        with pytest.raises(type(error)):
+            run_or_failure(Failing(error), {})
 
 
 def test_case_rejects_unknown_setting_and_name():

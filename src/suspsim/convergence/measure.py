@@ -51,13 +51,12 @@ def run_configuration(case: AnyCase, overrides: Mapping[str, Any] | None = None,
 
 def run_or_failure(case: AnyCase, overrides: Mapping[str, Any] | None = None, *,
                    threads: int = 1) -> dict[str, Any]:
-    """:func:`run_configuration`, or for a run that blew up the settings with its ``failure``
-    message (the sweep keeps it as a configuration with NaN measurements). A ValueError counts
-    as a blow-up: positions that went NaN between two health checks fail in the profile
-    binning."""
+    """:func:`run_configuration`, or for a run that blew up (NumericalError) the settings with
+    its ``failure`` message (the sweep keeps it as a configuration with NaN measurements). Any
+    other error propagates: a bad setting or a bug is not a blow-up."""
     try:
         return run_configuration(case, overrides, threads=threads)
-    except (NumericalError, ValueError) as err:
+    except NumericalError as err:
         log.warning("%s %s blew up: %s: %s", case.name, dict(overrides or {}),
                     type(err).__name__, err)
         return {**case.settings(overrides), "failure": f"{type(err).__name__}: {err}",

@@ -35,6 +35,7 @@ from suspsim.bodies.coupling import body_force_torque, place_body_particles
 from suspsim.bodies.grain_contacts import grain_surfaces
 from suspsim.bodies.grain_lubrication_pass import grain_lubrication_pass
 from suspsim.bodies.lubrication_pass import OVERLAPS, SMALLEST_GAP, lubrication_pass
+from suspsim.errors import NumericalError
 from suspsim.rheology.laws import make_law
 from suspsim.scene import Scene
 from suspsim.sph import kernels
@@ -624,7 +625,11 @@ class Simulation:
 
     def profiles(self, bins: int) -> dict[str, np.ndarray]:
         """Bin means over y ∈ [0, L_y): y, velocity_profile (v_x), viscosity_profile (μ),
-        shear_rate_profile (γ̇; NaN when no gradient pass runs), density_profile (ρ)."""
+        shear_rate_profile (γ̇; NaN when no gradient pass runs), density_profile (ρ).
+        Raises NumericalError (the message of :meth:`health`) when a position is not finite:
+        a run that blew up since its last health check has no bin to put it in."""
+        if not np.all(np.isfinite(self._x)):
+            raise NumericalError(self.health()[1])
         ly = self.scene.box[1]
         crossings = np.floor(self._x[:, 1] / ly)
         y = self._x[:, 1] - crossings * ly

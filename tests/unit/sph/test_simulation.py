@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from sph_helpers import couette_scene
+from suspsim.errors import NumericalError
 from suspsim.scene import scene_from_dict
 from suspsim.sph.lattice import imposed_velocity
 from suspsim.sph.simulation import Simulation
@@ -34,6 +35,10 @@ def test_api_end_to_end_newtonian_couette():
                              "density_profile"}
     assert all(p.shape == (8,) for p in profiles.values())
     np.testing.assert_allclose(profiles["viscosity_profile"], 1.0)
+    # A position that went NaN between health checks is a blow-up, not a binning error.
+    sim._x[3, 1] = np.nan
+    with pytest.raises(NumericalError, match="blew up; lower run.dt"):
+        sim.profiles(8)
 
 
 @pytest.mark.parametrize("law, params, bulk", [("newtonian", {"mu": 1.0}, True),
