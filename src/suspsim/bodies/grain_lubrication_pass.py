@@ -47,7 +47,7 @@ from .grain_contacts import (C_A, C_B, CONTACT_WIDTH, GAP, INDEX_A, INDEX_B, RAD
                              grain_pair_contact)
 from .lubrication import curved_squeeze_coefficient_frames, gap_viscosity, sphere_squeeze_law
 from .lubrication_implicit import lubrication_pair_impulse_law
-from .lubrication_pass import OVERLAPS, PAIRS, SMALLEST_GAP, record_pair
+from .lubrication_pass import SMALLEST_GAP, clear_pass_records, record_pair
 
 __all__ = ["grain_lubrication_pass", "grain_pair_impulse"]
 
@@ -155,10 +155,7 @@ def grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments
         _inverse_inertia(rotations[b], moments[b], inv_inertia[b])
         scalar[b] = (moments[b, 0] + moments[b, 1] + moments[b, 2]) / 3.0
         extra[b] = np.sqrt(centroids[b, 0] ** 2 + centroids[b, 1] ** 2 + centroids[b, 2] ** 2)
-    virial[:] = 0.0
-    stats[SMALLEST_GAP] = np.inf
-    stats[PAIRS] = 0.0
-    stats[OVERLAPS] = 0.0
+    clear_pass_records(virial, stats)
     for p in range(n):
         for q in range(p + 1, n):
             dx, dy, dz, image = minimum_image_3d(centres[p, 0] - centres[q, 0],

@@ -48,10 +48,7 @@ def lubrication_pass(centres, radii, velocities, omegas, mass, inertia, box, le_
     r12 = np.zeros(3)
     u2 = np.zeros(3)
     zero = np.zeros(3)
-    virial[:] = 0.0
-    stats[SMALLEST_GAP] = np.inf
-    stats[PAIRS] = 0.0
-    stats[OVERLAPS] = 0.0
+    clear_pass_records(virial, stats)
     n = centres.shape[0]
     for p in range(n):
         for q in range(p + 1, n):
@@ -80,6 +77,15 @@ def lubrication_pass(centres, radii, velocities, omegas, mass, inertia, box, le_
                 omegas[p, k] += out[2, k] / inertia[p]
                 omegas[q, k] += out[3, k] / inertia[q]
             record_pair(s_new, out, dt, dx, dy, dz, virial, stats)
+
+
+@njit(**JIT_OPTIONS)
+def clear_pass_records(virial, stats):
+    """Zero ``virial`` and the pair counts of ``stats``, smallest gap +∞, before a pass."""
+    virial[:] = 0.0
+    stats[SMALLEST_GAP] = np.inf
+    stats[PAIRS] = 0.0
+    stats[OVERLAPS] = 0.0
 
 
 @njit(**JIT_OPTIONS)
