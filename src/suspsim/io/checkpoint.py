@@ -29,7 +29,7 @@ from .atomic import atomic_path
 log = logging.getLogger(__name__)
 
 FORMAT = "suspsim-checkpoint"
-#: 2: body particles take μ̂ from the fluid beside them, held in the state (``body_viscosity``).
+#: 2: body particles take μ̂ (``viscosity_hat``) from the fluid beside them (2026-12-05).
 FORMAT_VERSION = 2
 #: Scene keys that do not change the physics and may differ when a run resumes.
 RESUMABLE_KEYS = (("run", "threads"), ("run", "checkpoint_interval_s"),

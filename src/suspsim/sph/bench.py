@@ -163,8 +163,7 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
         calls["body density"] = lambda: body_particle_density(
             tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._body_of, sim._kernel,
             SUPPORT, sim._rho, sim._rho_eq, sim.sound_speed ** 2, sim._mass, sim._mu_hat,
-            sim._grad_acc[:3 * n], sim._scratch_15[:, :3 * n], sim._bounds, sim._volume,
-            sim._body_mu)
+            sim._grad_acc[:3 * n], sim._scratch_15[:, :3 * n], sim._bounds, sim._volume)
     if sim._velocity_gradient:
         calls["gradient sums"] = lambda: _gradient_sums(
             tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
@@ -181,7 +180,7 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
                 sim._diss_acc, sim._scratch_1, sim._bounds)
         calls["normalisation finish"] = lambda: _normalisation_finish(
             sim._diss_acc, sim._dissipation, sim._gradient, sim._moment_trace, sim._mu,
-            sim._alpha, sim._beta, sim.scene.dimension, sim._factor, sim._mu_hat)
+            sim._alpha, sim._beta, sim.scene.dimension, sim._body_of, sim._factor, sim._mu_hat)
     calls["force sums"] = lambda: force_sums(
         tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
         sim._v, sim._rho, sim._volume, sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2,

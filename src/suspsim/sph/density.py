@@ -335,7 +335,7 @@ def _shepard_loop(lo, hi, pair_start, pair_end, pair_j, geometry, body_of, kerne
 
 @njit(parallel=True, **JIT_OPTIONS)
 def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho, rho_eq,
-                          c2, mass, viscosity_hat, acc, scratch, bounds, volume, body_viscosity):
+                          c2, mass, viscosity_hat, acc, scratch, bounds, volume):
     """Density and viscosity of rigid-body particles from the fluid around them.
 
     A body particle j takes the Shepard average of its fluid neighbours' pressures,
@@ -346,11 +346,11 @@ def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kerne
     relaxation, a tension that pulls fluid onto the surface and kept the relaxation from
     converging). A body particle without fluid neighbours gets ρ_eq.
 
-    Likewise ``body_viscosity`` μ̂_j = Σ_f μ̂_f W_jf / Σ_f W_jf [choice], the normalised
+    Likewise its μ̂_j = Σ_f μ̂_f W_jf / Σ_f W_jf in ``viscosity_hat`` [choice], the normalised
     viscosity of the fluid beside it, which a pair of particles of two different bodies uses
     (a fluid–body pair takes the fluid's μ̂ at both ends, ``force_pass``). μ̂_f is the previous
-    step's (this step's is computed later from the volumes set here); a body particle without
-    fluid neighbours keeps its value. Pairs inside one body have no force (the body moves
+    step's (this step's is computed later from the volumes set here; the normalisation leaves
+    body particles' μ̂ alone); a body particle without fluid neighbours keeps its value. Pairs inside one body have no force (the body moves
     rigidly) and, with density and μ̂ taken from the fluid, no other use, so the list leaves
     them out (``group`` of ``neighbours.build_neighbour_list``; a fifth of the pairs within h
     at φ = 0.4). A body particle's own rate and dissipation factor then come from a one-sided
@@ -380,13 +380,4 @@ def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kerne
             rho[i] = rho_eq + p / c2
             volume[i] = mass / rho[i]
             if weight > 0.0:
-                body_viscosity[i] = acc[3 * i + 2] / weight
-
-
-@njit(parallel=True, **JIT_OPTIONS)
-def set_body_viscosity(body_of, body_viscosity, viscosity_hat):
-    """μ̂_i = ``body_viscosity``[i] for every body particle i (after the normalisation, which
-    computes a meaningless μ̂ from a body particle's one-sided neighbourhood)."""
-    for i in prange(body_of.shape[0]):
-        if body_of[i] >= 0:
-            viscosity_hat[i] = body_viscosity[i]
+                viscosity_hat[i] = acc[3 * i + 2] / weight

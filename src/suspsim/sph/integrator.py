@@ -25,7 +25,7 @@ from numba import njit, prange
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.boundaries import lees_edwards_offset
 from suspsim.sph.density import (TABLE_OK, body_particle_density, mass_density,
-                                 set_body_viscosity, summation_density)
+                                 summation_density)
 from suspsim.sph.neighbours import needs_rebuild
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
@@ -74,8 +74,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
                   pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
                   inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
-                  viscosity_hat, body_viscosity, grad_acc, diss_acc, force_acc, scratch_1,
-                  scratch_15, force_scratch, bounds, virial, accel_out):
+                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
+                  force_scratch, bounds, virial, accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
 
     Returns ``density.TABLE_OK``, or ``density.TABLE_OVERFLOW`` straight after the density pass
@@ -90,8 +90,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     ``bulk_gradient`` the ∇a sums (B on and μ varying). ``has_bodies``: the scene has rigid
     bodies, whose particles (``body_of`` (N,) ≥ 0; −1 for fluid) have no pairs inside their
     own body in the list (``group`` of ``neighbours.build_neighbour_list``) and take their
-    density and μ̂ (``body_viscosity`` (N,)) from the fluid around them
-    (``density.body_particle_density``); their gradient, rate and inverse moment are 0
+    density and μ̂ from the fluid around them (``density.body_particle_density``); their
+    gradient, rate and inverse moment are 0 and the normalisation keeps their μ̂
     (``velocity_pass``).
     """
     shear_ly = shear_rate * box[1]
@@ -105,7 +105,7 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
         n = rho.shape[0]
         body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kernel, h, rho,
                               rho_eq, c2, mass, viscosity_hat, grad_acc[:3 * n],
-                              scratch_15[:, :3 * n], bounds, volume, body_viscosity)
+                              scratch_15[:, :3 * n], bounds, volume)
     held = (normalise and newtonian
             and not normalisation_due(normalisation_age, normalisation_interval))
     if velocity_gradient and not held:
@@ -124,11 +124,11 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
             _dissipation_sums(pair_start, pair_end, pair_j, geometry, volume, strain, diss_acc,
                               scratch_1, bounds)
         _normalisation_finish(diss_acc, dissipation, gradient, moment_trace, viscosity, alpha,
-                              beta, dimension, factor, viscosity_hat)
+                              beta, dimension, body_of, factor, viscosity_hat)
     elif not newtonian:
-        viscosity_hat[:] = viscosity
-    if has_bodies:
-        set_body_viscosity(body_of, body_viscosity, viscosity_hat)
+        for i in range(viscosity.shape[0]):
+            if body_of[i] < 0:
+                viscosity_hat[i] = viscosity[i]
     force_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
                volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
                shear_ly, body_of, pressure, force_acc, force_scratch, bounds, virial)
@@ -146,8 +146,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
                   pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
                   inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
-                  viscosity_hat, body_viscosity, grad_acc, diss_acc, force_acc, scratch_1,
-                  scratch_15, force_scratch, bounds, virial):
+                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
+                  force_scratch, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, stop).
 
     stop is :data:`DONE`, or :data:`REBUILD` or :data:`GROW_TABLE`: the drift of step
@@ -172,8 +172,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
             alpha, beta, bulk_factor, bulk_gradient,
             has_bodies, body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
             pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation,
-            gdot, viscosity, factor, viscosity_hat, body_viscosity, grad_acc, diss_acc, force_acc,
-            scratch_1, scratch_15, force_scratch, bounds, virial, accel_new)
+            gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
+            scratch_15, force_scratch, bounds, virial, accel_new)
         if code != TABLE_OK:
             return done, GROW_TABLE
         kick(velocities, accel, accel_new, dt)

@@ -73,7 +73,7 @@ _STATE_ARRAYS = {"positions": "_x", "velocities": "_v", "accelerations": "_a",
                  "normalisation_factor": "_factor", "viscosity_hat": "_mu_hat",
                  "velocity_gradient": "_gradient", "inverse_moment": "_inverse_moment",
                  "virial": "_virial", "reference": "_reference", "body_of": "_body_of",
-                 "body_offsets": "_offsets", "body_viscosity": "_body_mu"}
+                 "body_offsets": "_offsets"}
 
 
 class Simulation:
@@ -157,6 +157,9 @@ class Simulation:
         if _state is None and self.bodies is not None:
             self._body_of[:] = setup.body_of
             self._offsets[:] = setup.offsets
+            # A body particle's μ̂ is the fluid's beside it; one without fluid neighbours keeps
+            # its value (``density.body_particle_density``), so it starts at the imposed rate's.
+            self._mu_hat[self._body_of >= 0] = float(scene.fluid.law.viscosity(self._rate))
         if _state is None:
             self._rebuild(0.0)
             if scene.lattice.relax:
@@ -218,10 +221,6 @@ class Simulation:
         self._virial = np.zeros((t, 5))
         self._body_of = np.full(n, -1, dtype=np.int64)
         self._offsets = np.zeros((n if self.bodies is not None else 0, 3))
-        # μ̂ of body particles from the fluid beside them (``density.body_particle_density``);
-        # one without fluid neighbours keeps its value, so it starts at the imposed rate's μ.
-        self._body_mu = np.full(n if self.bodies is not None else 0,
-                                float(self.scene.fluid.law.viscosity(self._rate)))
         self._members = np.zeros(0, dtype=np.int64)
         self._body_virial = np.zeros(5)
         self._lubrication_virial = np.zeros(5)
@@ -262,10 +261,10 @@ class Simulation:
         return float(lees_edwards_offset(self._rate, self._box[0], self._box[1], time))
 
     def _permuted_arrays(self) -> tuple:
-        """Particle arrays a rebuild reorders besides x and v. With bodies also their offsets,
-        μ̂ (the next step's body particles average the fluid's, ``density.body_particle_density``,
-        before the fluid's own is recomputed) and the body particles' μ̂."""
-        return (self._a, self._body_of) + ((self._offsets, self._mu_hat, self._body_mu)
+        """Particle arrays a rebuild reorders besides x and v. With bodies also their offsets
+        and μ̂ (the next step's body particles average the fluid's, and keep their own without
+        fluid beside them: ``density.body_particle_density``)."""
+        return (self._a, self._body_of) + ((self._offsets, self._mu_hat)
                                            if self.bodies is not None else ())
 
     def _rebuild(self, time: float) -> None:
@@ -318,7 +317,7 @@ class Simulation:
                 self._pressure, tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry,
                 tb.pair_cross, tb.pair_image, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
-                self._gdot, self._mu, self._factor, self._mu_hat, self._body_mu, self._grad_acc,
+                self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
                 self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,
                 self._force_scratch, self._bounds, self._virial)
 

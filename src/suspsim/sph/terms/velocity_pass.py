@@ -7,9 +7,10 @@ scheduling. Velocities are the predicted ṽ of the integrator (the viscosity up
 SPEC §2.6); a pair across a sheared face has v_ij,x −= n γ̇ L_y (SPEC §2.7; the table's
 pairs from ``pair_cross[i]`` on, with n in ``pair_image``).
 
-Pass 1 (:func:`gradient_pass`): per particle G (9) and M2 (6) (``gradient``), then per particle
-g = M2⁻¹ G, γ̇ and, for a non-Newtonian law, μ = viscosity_kernel(code, params, γ̇).
-Pass 2 (:func:`normalisation_pass`): D_i = α Σ_j V_j F (r·S_i r)²/r² + β (L Lᵀ):M2
+Pass 1 (:func:`_gradient_sums`, then :func:`_gradient_finish`): per particle G (9) and M2 (6)
+(``gradient``), then per particle g = M2⁻¹ G, γ̇ and, for a non-Newtonian law,
+μ = viscosity_kernel(code, params, γ̇). Pass 2 (:func:`_dissipation_sums`, then
+:func:`_normalisation_finish`): D_i = α Σ_j V_j F (r·S_i r)²/r² + β (L Lᵀ):M2
 (``normalisation``; the β part is per particle, from pass 1), then s_i and μ̂_i = μ_i/s_i.
 Without the normalisation μ̂ = μ and pass 2 is skipped; with α = 0 (2D with the bulk
 correction) only its per-particle half runs. A Newtonian fluid needs both passes only for
@@ -248,17 +249,6 @@ def _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise,
             viscosity[i] = viscosity_kernel(law_code, law_params, gdot[i])
 
 
-def gradient_pass(start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity, volume,
-                  shear_ly, dimension, law_code, law_params, newtonian, normalise, beta, acc,
-                  scratch, bounds, gradient, inverse_moment, moment_trace, gdot, viscosity, strain,
-                  dissipation, body_of):
-    """Python entry of pass 1 (the integrator calls the two compiled halves directly)."""
-    _gradient_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity, volume,
-                   shear_ly, dimension, acc, scratch, bounds)
-    _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise, beta, body_of,
-                     gradient, inverse_moment, moment_trace, gdot, viscosity, strain, dissipation)
-
-
 @njit(inline="always", **JIT_OPTIONS)
 def _dissipation_loop(lo, hi, start, pair_end, pair_j, geometry, volume, strain, acc):
     """acc[i] += Σ_j V_j F (r·S_i r)²/r² for particles lo..hi−1, both ends of each pair."""
@@ -299,9 +289,13 @@ def _dissipation_sums(start, pair_end, pair_j, geometry, volume, strain, acc, sc
 
 @njit(parallel=True, **JIT_OPTIONS)
 def _normalisation_finish(acc, dissipation, gradient, moment_trace, viscosity, alpha, beta,
-                          dimension, factor, viscosity_hat):
-    """D_i = α acc_i + β (L Lᵀ):M2 (``dissipation``), s_i = D_i/D_c and μ̂_i = μ_i/s_i."""
+                          dimension, body_of, factor, viscosity_hat):
+    """D_i = α acc_i + β (L Lᵀ):M2 (``dissipation``), s_i = D_i/D_c and μ̂_i = μ_i/s_i of the
+    fluid particles; a rigid-body particle (``body_of`` ≥ 0) keeps its μ̂, the fluid's beside
+    it (``density.body_particle_density``)."""
     for i in prange(viscosity.shape[0]):
+        if body_of[i] >= 0:
+            continue
         g = gradient[i]
         norm2 = 0.0
         for k in range(9):
@@ -311,20 +305,6 @@ def _normalisation_finish(acc, dissipation, gradient, moment_trace, viscosity, a
                                  moment_trace[i], dimension)
         factor[i] = s
         viscosity_hat[i] = viscosity[i] / s
-
-
-def normalisation_pass(start, pair_end, pair_j, geometry, volume, strain, gradient, moment_trace,
-                       viscosity, alpha, beta, dimension, acc, scratch, bounds, dissipation,
-                       factor, viscosity_hat):
-    """Python entry of pass 2 (the integrator calls the compiled halves directly); the pair
-    sums run only when α ≠ 0."""
-    if alpha != 0.0:
-        _dissipation_sums(start, pair_end, pair_j, geometry, volume, strain, acc, scratch,
-                          bounds)
-    else:
-        acc[:] = 0.0
-    _normalisation_finish(acc, dissipation, gradient, moment_trace, viscosity, alpha, beta,
-                          dimension, factor, viscosity_hat)
 
 
 @njit(**JIT_OPTIONS)
