@@ -1,7 +1,7 @@
 """Dense spheres at increasing resolution: η_r against the sphere radius in kernel units.
 
     python docs/figures/make_sphere_resolution.py [--phi 0.4] [--radii 2.5 3.333 4.167]
-        [--seeds 1] [--strain 1 4]
+        [--seeds 1] [--strain 1 4] [--set KEY=VALUE ...]
 
 At a = 2.5 h the dense suspensions read below the published envelope (README, Suspensions),
 and at φ = 0.3 a = 3.33 h read 15–35 % higher: the near field of a crowd is under-resolved.
@@ -9,9 +9,11 @@ This measures how η_r converges with a/h at fixed φ and fixed box/a = 6 (the s
 spheres, about 21 at φ = 0.4, so only the resolution changes; the side rounded to whole
 lattice spacings), in the Newtonian matrix of
 :mod:`suspsim.validation.suspension`, one thread per run. Prints a Markdown table (η_r ± the
-strain-unit standard error, CPU time, particles) and writes nothing else.
+strain-unit standard error, CPU time, particles) and writes nothing else. ``--set`` takes a
+scene key for every run (e.g. ``inclusions.lubrication.friction=0.5``).
 """
 import argparse
+import json
 
 from suspsim.rheology.suspension import published_envelope
 from suspsim.validation.suspension import NUMBER_DENSITY, relative_viscosity
@@ -28,17 +30,22 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[1])
     parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 4.0],
                         metavar=("TRANSIENT", "UNITS"))
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="a scene key for every run (repeatable)")
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
+    overrides = {key: json.loads(value) for key, value in
+                 (item.split("=", 1) for item in args.set)}
+    settings = "".join(f", {key} = {value}" for key, value in overrides.items())
     low, high = published_envelope(args.phi)
     print(f"φ = {args.phi} (published envelope {low:.2f}–{high:.2f}), box {BOX_PER_RADIUS:g} a, "
-          f"strain {transient:g} + {units}\n| a [h] | box [h] | seed | φ packed | η_r | "
+          f"strain {transient:g} + {units}{settings}\n| a [h] | box [h] | seed | φ packed | η_r | "
           "CPU [s] | particles |\n|---|---|---|---|---|---|---|", flush=True)
     for radius in args.radii:
         for seed in args.seeds:
             box = SPACING * round(BOX_PER_RADIUS * radius / SPACING)
             r = relative_viscosity(phi=args.phi, radius=radius, box=box, seed=seed,
-                                   transient=transient, units=units)
+                                   transient=transient, units=units, overrides=overrides)
             print(f"| {radius:g} | {box:g} | {seed} | {r.phi:.3f} | {r.relative_viscosity:.3f} "
                   f"± {r.stderr:.3f} | {r.cpu_time:.0f} | {r.n_particles} |", flush=True)
 

@@ -118,12 +118,13 @@ class NumericsSpec:
 @dataclass(frozen=True)
 class LubricationSpec:
     """Lubrication between bodies (SPEC §3.3): ``enabled``, ``cutoff_gap`` s_c [h], ``min_gap``
-    s_min [h], ``repulsion`` k [1] (schema ``inclusions.lubrication``)."""
+    s_min [h], ``repulsion`` k [1], ``friction`` μ_c [1] (schema ``inclusions.lubrication``)."""
 
     enabled: bool
     cutoff_gap: float
     min_gap: float
     repulsion: float
+    friction: float
 
 
 @dataclass(frozen=True)
@@ -247,7 +248,7 @@ def _inclusions(data: Mapping[str, Any]) -> InclusionsSpec:
               for f in fields(InclusionsSpec) if f.name != "lubrication"}
     return InclusionsSpec(**values, lubrication=LubricationSpec(
         bool(lub["enabled"]), float(lub["cutoff_gap"]), float(lub["min_gap"]),
-        float(lub["repulsion"])))
+        float(lub["repulsion"]), float(lub["friction"])))
 
 
 def load_scene(path: str | PathLike) -> Scene:

@@ -28,6 +28,17 @@ since W is positive definite and M semi-definite); the twist rate ω_n' = ω_n*/
 force (module :mod:`~suspsim.bodies.lubrication`), so momentum and angular momentum about any
 point are conserved exactly, and the step is unconditionally stable (L-stable).
 
+**Contact friction** [choice, not in SPEC; Coulomb friction at roughness contacts as in Mari,
+Seto, Morris & Denn, J. Rheol. 58, 1693 (2014), taken here history-free and implicit as in
+Moreau–Jean contact dynamics]. Seed 000's repulsion stands for the contact of surface asperities;
+with a coefficient μ_c > 0 that contact also resists sliding. After the lubrication solve, the
+sliding velocity left at the contact points, σ', is stopped by a tangential impulse J_f at the
+contact (a generalized sliding force, so it changes σ by W_σσ J_f and the spins through the same
+lever arms) if that needs no more than μ_c j_rep (stick, J_f = −σ'/W_σσ); otherwise J_f =
+−μ_c j_rep σ'/|σ'| (slip). j_rep is the repulsion's impulse over the step, so pairs the
+repulsion does not reach feel no friction. The split (lubrication, then friction on its result)
+is first order in δt and stable at any step: the friction impulse only removes sliding.
+
 Assumptions: positions are frozen at the start of the step (d, κ, s for the tangential modes);
 the viscosity ``mu`` is supplied by the caller (lagged, e.g. :func:`gap_viscosity` at the
 predicted velocities); the integrator moves positions by δt × the corrected velocities; pairs are
@@ -38,6 +49,8 @@ Units as in :mod:`~suspsim.bodies.lubrication` ([h], [τ], [m]); impulses [m h �
 impulses [m h² τ⁻¹]; dividing by δt gives the step-mean force for the stress (SPEC §3.5).
 """
 from __future__ import annotations
+
+import math
 
 from numba import njit
 
@@ -100,8 +113,9 @@ def implicit_normal_gap(s, x_star, w, dt, mu, c1, c2, c3, ell, cutoff_gap, min_g
 
 @njit(**JIT_OPTIONS)
 def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2,
-                             dt, mu, cutoff_gap, min_gap, repulsion_strength, out):
-    """Implicit lubrication + repulsion impulses of a sphere pair over one step.
+                             dt, mu, cutoff_gap, min_gap, repulsion_strength, friction, out):
+    """Implicit lubrication + repulsion (+ contact friction) impulses of a sphere pair over one
+    step.
 
     Inputs: radii a1, a2 [h]; ``r12`` = x1 − x2 [h] at the start of the step; velocities U1, U2
     [h τ⁻¹] and angular velocities W1, W2 [τ⁻¹] before the update; dU1, dU2, dW1, dW2 their
@@ -109,7 +123,8 @@ def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1
     scalar moments of inertia I1, I2 [m h²] (inf for a fixed body); ``dt`` [τ]; ``mu`` the gap
     viscosity; ``cutoff_gap``, ``min_gap``, ``repulsion_strength`` as in
     :func:`~suspsim.bodies.lubrication.lubrication_pair_force` and
-    :func:`~suspsim.bodies.lubrication.repulsion_force`.
+    :func:`~suspsim.bodies.lubrication.repulsion_force`; ``friction`` the Coulomb coefficient
+    μ_c [1] of the contact the repulsion stands for (module docstring; 0: frictionless).
 
     Writes ``out`` (4, 3): rows J1, J2 (impulses on 1 and 2, J2 = −J1) and L1, L2 (angular
     impulses); the new velocities are U + dU + J/m, Ω + dΩ + L/I. Returns the predicted gap at
@@ -118,13 +133,14 @@ def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1
     """
     c1, c2, c3, ell = sphere_squeeze_law(a1, a2)
     return _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt,
-                         mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, out)
+                         mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, friction,
+                         out)
 
 
 @njit(**JIT_OPTIONS)
 def lubrication_pair_impulse_law(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1,
                                  I2, dt, mu, c1, c2, c3, ell, cutoff_gap, min_gap,
-                                 repulsion_strength, out):
+                                 repulsion_strength, friction, out):
     """:func:`lubrication_pair_impulse` with the normal law (c1, c2, c3, ℓ) of
     :func:`~suspsim.bodies.lubrication.normal_resistance` given: e.g. c1 from the curvatures
     of two non-spherical surfaces (SPEC §3.4,
@@ -132,12 +148,13 @@ def lubrication_pair_impulse_law(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2
     spheres a1, a2 that osculate them (:mod:`~suspsim.bodies.grain_lubrication_pass`). The
     tangential and twist modes are those of the spheres a1, a2."""
     return _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt,
-                         mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, out)
+                         mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, friction,
+                         out)
 
 
 @njit(inline="always", **JIT_OPTIONS)
 def _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt, mu, c1, c2,
-                  c3, ell, cutoff_gap, min_gap, repulsion_strength, out):
+                  c3, ell, cutoff_gap, min_gap, repulsion_strength, friction, out):
     dx, dy, dz, s, kap = _pair_geometry(a1, a2, r12)
     out[:, :] = 0.0
     v1x, v1y, v1z = U1[0] + dU1[0], U1[1] + dU1[1], U1[2] + dU1[2]
@@ -195,6 +212,16 @@ def _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I
     frx = -dt * (k_sr * nsx + k_rr * nrx)
     fry = -dt * (k_sr * nsy + k_rr * nry)
     frz = -dt * (k_sr * nsz + k_rr * nrz)
+    if friction > 0.0 and j_rep > 0.0:
+        # Coulomb contact: stop the sliding left after lubrication, within μ_c j_rep
+        jfx, jfy, jfz = -nsx / w_ss, -nsy / w_ss, -nsz / w_ss
+        stick = math.sqrt(jfx * jfx + jfy * jfy + jfz * jfz)
+        limit = friction * j_rep
+        if stick > limit:
+            jfx, jfy, jfz = jfx * limit / stick, jfy * limit / stick, jfz * limit / stick
+        fsx += jfx
+        fsy += jfy
+        fsz += jfz
     k_t = mu * m_t
     jt = -dt * k_t * wn / (1.0 + dt * k_t * w_rr)
     out[0, 0] = fsx - jn * dx

@@ -350,7 +350,7 @@ def drive_pair(steps, repulsion, implicit=True, s0=S0, cutoff=CUTOFF):
         if implicit:
             lubrication_pair_impulse(A, A, x1 - x2, u1, u2, w1, w2, du1, du2, np.zeros(3),
                                      np.zeros(3), MASS, MASS, inertia, inertia, DT, MU, cutoff,
-                                     MIN_GAP, repulsion, out)
+                                     MIN_GAP, repulsion, 0.0, out)
             u1, u2 = u1 + du1 + out[0] / MASS, u2 + du2 + out[1] / MASS
         else:
             s = lub.lubrication_pair_force(A, A, x1 - x2, u1, u2, w1, w2, MU, cutoff, MIN_GAP, out)
@@ -431,7 +431,7 @@ def test_implicit_tangential_modes_equal_dense_backward_euler():
     du2 += ((u1 + du1 - u2 - du2) @ d) * d                # zero relative normal velocity
     out = np.zeros((4, 3))
     s_new = lubrication_pair_impulse(a1, a2, r12, u1, u2, w1, w2, du1, du2, dw1, dw2, m1, m2,
-                                     i1, i2, dt, mu, 0.3, 1e-4, 0.0, out)
+                                     i1, i2, dt, mu, 0.3, 1e-4, 0.0, 0.0, out)
     assert s_new == pytest.approx(s, rel=1e-12)
     mass = np.diag(np.repeat([m1, m2, i1, i2], 3))
     v_star = np.concatenate([u1 + du1, u2 + du2, w1 + dw1, w2 + dw2])
@@ -452,7 +452,7 @@ def test_implicit_impulses_conserve_momentum_and_dissipate():
         r12 = pair_r12(a1, a2, 0.02, rng.normal(size=3))
         v = rng.normal(size=(4, 3))
         lubrication_pair_impulse(a1, a2, r12, v[0], v[1], v[2], v[3], *np.zeros((4, 3)), m1, m2,
-                                 i1, i2, dt, 1.0, 0.3, 1e-4, 1e-22, out)
+                                 i1, i2, dt, 1.0, 0.3, 1e-4, 1e-22, 0.0, out)
         scale = np.abs(out).max()
         assert scale > 0
         assert np.allclose(out[0], -out[1], rtol=0, atol=1e-14 * scale)
@@ -462,6 +462,89 @@ def test_implicit_impulses_conserve_momentum_and_dissipate():
         ke0 = 0.5 * np.sum(mass * v * v)
         vn = v + out * inv
         assert 0.5 * np.sum(mass * vn * vn) <= ke0 * (1 + 1e-12)
+
+
+# ------------------------------------------------------------------------------------------
+# Contact friction (a [choice] beyond SPEC: Coulomb, at the repulsion's contacts)
+
+def _pressed_pair(rng, s=0.06):
+    """Unequal spheres at gap s (inside the repulsion's reach), pushed together, with random
+    sliding and spins: (a1, a2, r12, velocities (4, 3), masses, moments, dt, cutoff, min_gap, C)."""
+    a1, a2 = 1.0, 0.7
+    r12 = pair_r12(a1, a2, s, rng.normal(size=3))
+    v = rng.normal(size=(4, 3))
+    d = -r12 / np.linalg.norm(r12)
+    v[0] += 2.0 * d                                 # 1 moves towards 2
+    return a1, a2, r12, v, (0.3, 0.1), (0.4 * 0.3, 0.4 * 0.1 * 0.49), 0.01, 0.3, 0.05, 1e-9
+
+
+def _impulse(pair, friction, repulsion=None):
+    a1, a2, r12, v, (m1, m2), (i1, i2), dt, cutoff, min_gap, c = pair
+    out = np.zeros((4, 3))
+    lubrication_pair_impulse(a1, a2, r12, v[0], v[1], v[2], v[3], *np.zeros((4, 3)), m1, m2, i1,
+                             i2, dt, 1.0, cutoff, min_gap, c if repulsion is None else repulsion,
+                             friction, out)
+    return out
+
+
+def _sliding(pair, out):
+    """Relative velocity of the contact points after the impulses ``out`` (σ of the mode form)."""
+    a1, a2, r12, v, (m1, m2), (i1, i2), *_ = pair
+    u1, u2 = v[0] + out[0] / m1, v[1] + out[1] / m2
+    w1, w2 = v[2] + out[2] / i1, v[3] + out[3] / i2
+    r = np.linalg.norm(r12)
+    d = -r12 / r
+    u = u1 - u2
+    return u - (u @ d) * d + r / (a1 + a2) * np.cross(a1 * w1 + a2 * w2, d)
+
+
+def _repulsion_impulse(pair):
+    a1, a2, r12, v, (m1, m2), _, dt, cutoff, min_gap, c = pair
+    d = -r12 / np.linalg.norm(r12)
+    s = np.linalg.norm(r12) - a1 - a2
+    c1, c2, c3, ell = lub.sphere_squeeze_law(a1, a2)
+    return implicit_normal_gap(s, -(v[0] - v[1]) @ d, 1 / m1 + 1 / m2, dt, 1.0, c1, c2, c3, ell,
+                               cutoff, min_gap, c)[2]
+
+
+def test_friction_sticks_within_its_cone_and_slips_at_its_limit():
+    """Stick: a large μ_c leaves no sliding at the contact points. Slip: a small μ_c adds a
+    tangential impulse of exactly μ_c j_rep against the sliding left by lubrication."""
+    rng = np.random.default_rng(41)
+    for _ in range(5):
+        pair = _pressed_pair(rng)
+        j_rep = _repulsion_impulse(pair)
+        assert j_rep > 0
+        plain = _impulse(pair, 0.0)
+        slide = _sliding(pair, plain)
+        assert np.linalg.norm(slide) > 1e-3
+        stuck = _impulse(pair, 1e6)
+        assert np.linalg.norm(_sliding(pair, stuck)) <= 1e-10 * np.linalg.norm(slide)
+        # |J_f| = 1e-3 |σ'| is far below the stick impulse |σ'|/W_σσ (W_σσ ≈ 47 here)
+        mu_c = 1e-3 * np.linalg.norm(slide) / j_rep
+        slip = _impulse(pair, mu_c)
+        extra = slip[0] - plain[0]
+        d = -pair[2] / np.linalg.norm(pair[2])
+        assert abs(extra @ d) <= 1e-12 * np.linalg.norm(extra)
+        assert np.linalg.norm(extra) == pytest.approx(mu_c * j_rep, rel=1e-10)
+        assert extra @ slide < 0
+
+
+def test_friction_conserves_momentum_removes_energy_and_needs_a_contact():
+    rng = np.random.default_rng(43)
+    for friction in (0.1, 1.0, 1e6):
+        pair = _pressed_pair(rng)
+        a1, a2, r12, v, (m1, m2), (i1, i2), *_ = pair
+        out = _impulse(pair, friction)
+        scale = np.abs(out).max()
+        assert np.allclose(out[0], -out[1], rtol=0, atol=1e-14 * scale)
+        assert np.abs(out[2] + out[3] + np.cross(r12, out[0])).max() <= 1e-12 * scale
+        mass = np.array([m1, m2, i1, i2])[:, None]
+        energy = [0.5 * np.sum(mass * (v + o / mass) ** 2) for o in (_impulse(pair, 0.0), out)]
+        assert energy[1] < energy[0]
+        # no repulsion, no contact: friction changes nothing
+        assert np.array_equal(_impulse(pair, friction, repulsion=0.0),
+                              _impulse(pair, 0.0, repulsion=0.0))
 
 
 # ------------------------------------------------------------------------------------------
