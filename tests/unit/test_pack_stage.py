@@ -18,10 +18,12 @@ SMALL = Particles(radius=1.0)
 def test_sheet_overrides_the_study_and_gives_the_physical_radius():
     assert particle_settings(STUDY) == Particles()
     assert particle_settings(STUDY, {"shape": None, "polydispersity": None}) == Particles()
-    merged = particle_settings(STUDY, {"shape": "sand", "polydispersity": 0.3, "size_ratio": 3,
-                                       "radius_m": 2e-4})
+    merged = particle_settings({**STUDY, "friction": 0.5},
+                               {"shape": "sand", "polydispersity": 0.3, "size_ratio": 3,
+                                "radius_m": 2e-4, "friction": 0.7})
     assert merged == Particles(shape="sand", radius=2.5, polydispersity=0.3, size_ratio=3,
-                               physical_radius=2e-4)
+                               physical_radius=2e-4, friction=0.7)
+    assert particle_settings({**STUDY, "friction": 0.5}).friction == 0.5
     assert Particles.from_mapping(merged.to_dict()) == merged
 
 
@@ -30,6 +32,8 @@ def test_bad_particle_settings_are_input_errors():
         Particles(shape="cube")
     with pytest.raises(InputError, match="physical_radius must be positive"):
         Particles(physical_radius=0.0)
+    with pytest.raises(InputError, match="friction must be >= 0"):
+        Particles(friction=-0.1)
     with pytest.raises(InputError, match="unknown key"):
         Particles.from_mapping({"radius": 1.0, "colour": "red"})
 

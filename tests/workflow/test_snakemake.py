@@ -205,6 +205,20 @@ def test_changing_one_volume_fraction_reruns_only_its_column(tmp_path):
     assert {job["phi"] for job in _dry_jobs(dry, "simulate")} == {"0.25"}
 
 
+def test_friction_reruns_the_suspension_runs_but_not_their_packings(tmp_path):
+    study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
+    spheres = ["--configfile", "config/studies/spheres.yaml"]
+    _placeholders(study, *spheres)
+    (study / "data/linear_polymer/material.yaml").write_text("particles: {friction: 0.5}\n")
+    dry = _run(study, "-n", *spheres)
+    config = yaml.safe_load((study / "config/studies/spheres.yaml").read_text())["simulation"]
+    suspensions = (sum(phi > 0 for phi in config["volume_fractions"])
+                   * len(config["shear_rates"]) * len(config["seeds"]))
+    assert _jobs(dry) == {"simulate": suspensions, "gather": 1, "plot_summary": 1, "all": 1}
+    assert {job["phi"] for job in _dry_jobs(dry, "simulate")} == {
+        f"{phi:g}" for phi in config["volume_fractions"] if phi > 0}
+
+
 def test_a_suspension_run_goes_through_pack_and_simulate(tmp_path):
     study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
     config = study / "config/studies/smoke.yaml"

@@ -157,8 +157,10 @@ def run_particles(wildcards):
 
 
 def pack_particles(wildcards):
-    """The material's particle settings that shape its packings (the physical radius does not)."""
-    return {k: v for k, v in PARTICLES[wildcards.material].items() if k != "physical_radius"}
+    """The material's particle settings that shape its packings (the physical radius and the
+    friction do not)."""
+    return {k: v for k, v in PARTICLES[wildcards.material].items()
+            if k not in ("physical_radius", "friction")}
 
 
 def run_shear_rate(wildcards):

@@ -51,7 +51,8 @@ class Particles:
     length of the runs with inclusions; ``polydispersity`` coefficient of variation of the
     radii [1]; ``size_ratio`` largest/smallest radius bound [1]; ``physical_radius`` the
     particles' mean radius [m] when the material sheet gives it (it sets the length scale
-    physical_radius/radius [m per h]), else None.
+    physical_radius/radius [m per h]), else None; ``friction`` the Coulomb coefficient of their
+    contacts [1] (the scene's ``inclusions.lubrication.friction``; it does not shape packings).
     """
 
     shape: str = "sphere"
@@ -59,6 +60,7 @@ class Particles:
     polydispersity: float = 0.0
     size_ratio: float = 5.0
     physical_radius: float | None = None
+    friction: float = 0.0
 
     def __post_init__(self):
         if self.shape not in SHAPES:
@@ -68,6 +70,8 @@ class Particles:
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value > 0):
                 raise InputError("particles", f"{name} must be positive, got {value!r}")
+        if not (math.isfinite(self.friction) and self.friction >= 0):
+            raise InputError("particles", f"friction must be >= 0, got {self.friction!r}")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-able values (a Snakemake param, a netCDF attribute)."""
@@ -85,11 +89,14 @@ class Particles:
 def particle_settings(study: Mapping[str, Any],
                       sheet: Mapping[str, Any] | None = None) -> Particles:
     """The study's ``simulation.inclusions`` block, overridden by a material sheet's
-    ``particles`` block (keys ``shape``, ``polydispersity``, ``size_ratio``, ``radius_m``)."""
+    ``particles`` block (keys ``shape``, ``polydispersity``, ``size_ratio``, ``friction``,
+    ``radius_m``)."""
     sheet = sheet or {}
-    values = {name: study[name] for name in ("shape", "radius", "polydispersity", "size_ratio")
+    values = {name: study[name] for name in ("shape", "radius", "polydispersity", "size_ratio",
+                                             "friction")
               if name in study}
-    values.update({name: sheet[name] for name in ("shape", "polydispersity", "size_ratio")
+    values.update({name: sheet[name] for name in ("shape", "polydispersity", "size_ratio",
+                                                  "friction")
                    if sheet.get(name) is not None})
     if sheet.get("radius_m") is not None:
         values["physical_radius"] = float(sheet["radius_m"])

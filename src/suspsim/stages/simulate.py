@@ -147,7 +147,8 @@ def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction
         inclusions.update(shape=particles.shape, radius=particles.radius,
                           polydispersity=particles.polydispersity,
                           size_ratio=particles.size_ratio, min_gap=STUDY_MIN_GAP,
-                          seed=int(seed), packing=None if packing is None else str(packing))
+                          seed=int(seed), packing=None if packing is None else str(packing),
+                          lubrication={"friction": particles.friction})
     data = {"dimension": 3, "box": [resolution.box] * 3,
             "number_density": resolution.number_density,
             "fluid": {"law": sim_law.name, "params": dict(sim_law.params)},
@@ -292,6 +293,7 @@ def with_physical_results(run: xr.Dataset, mapping: UnitMapping, *, scene: Scene
     out.attrs["resolution"] = json.dumps(asdict(resolution))
     settings = {name: value for name, value in asdict(spec).items()
                 if name in ("shape", "radius", "polydispersity", "size_ratio", "min_gap")}
+    settings["friction"] = spec.lubrication.friction
     if spec.present and mapping.length_scale is not None:
         settings["physical_radius"] = spec.radius * mapping.length_scale
     out.attrs["inclusions"] = json.dumps(settings) if spec.present else ""
