@@ -140,14 +140,20 @@ from suspsim.sph.timestep import (SUPPORT, auto_sound_speed, max_viscosity, stab
                                   stress_scale)
 
 #: The configuration grid the picker searches (per dimension for the resolution) [choice: the
-#: measured, stable range].
+#: measured, stable range]. Widths and sides step by 1.25 h (1.25–1.5× in 3D cost between
+#: neighbours; 2D q by 1.1–1.2×): a pick that has to round up to the next candidate pays at most
+#: that step. With the coarser grid (sides 5, 7.5, 10 h; widths 2.5, 3.75, 5, 7.5, 10, 15 h; 2D
+#: q 2.5, 3, 4, 5) the third blind set's picks cost 2.6–9.8× the cheapest configuration that met
+#: the tolerance, partly because the next candidate up cost 2.5–3.4× the one below it. 3D q
+#: stays 1.6, 2.4, 3.2: q = 2.8 would put the (2, 2, 0) lattice shell at r ≈ h, as q = 2 does
+#: the (2, 0, 0) shell (:data:`RESOLUTION_GAP`), and no training run measured it.
 GRID: dict[str, Any] = {
-    "resolution": {3: (1.6, 2.4, 3.2), 2: (2.5, 3.0, 4.0, 5.0)},
+    "resolution": {3: (1.6, 2.4, 3.2), 2: (2.5, 2.75, 3.0, 3.5, 4.0, 5.0)},
     "dt_coefficient": (0.05, 0.1, 0.2, 0.3, 0.4),
     "wi_target": (1e-3, 3e-3, 1e-2),
-    "side": (5.0, 7.5, 10.0),
+    "side": (5.0, 6.25, 7.5, 8.75, 10.0),
     "units": (2, 3, 4, 6),
-    "width": (2.5, 3.75, 5.0, 7.5, 10.0, 15.0),
+    "width": (2.5, 3.125, 3.75, 4.375, 5.0, 6.25, 7.5, 8.75, 10.0, 12.5, 15.0),
 }
 #: Snapped resolutions in this band are excluded: every training case measured 5–37 % error at
 #: q = 2 (lattice shells at the support radius), against < 1.5 % at q = 1.6 and 2.4.
