@@ -303,13 +303,33 @@ def test_bingham_number_bounded_by_the_trained_range():
                 courant=0.1, units=0.0, n_particles=100, n_steps=100, rows=24)
     bounds = {"resolution_poiseuille_3d": [1.6, 2.4], "inverse_length_poiseuille": [0.1, 0.5],
               "wi": [1e-3, 1e-2], "courant_poiseuille_rate_dependent_3d": [0.1, 1.0],
-              "courant_poiseuille_newtonian_3d": [0.1, 1.0], "bingham_poiseuille": [0.0, 5.0]}
+              "courant_poiseuille_newtonian_3d": [0.1, 1.0], "bingham_poiseuille": [0.0, 5.0],
+              "stepsupport_poiseuille_rate_dependent_3d": [0.01, 1.0],
+              "stepsupport_poiseuille_newtonian_3d": [0.01, 1.0]}
     model = em.ErrorModel({}, {}, 1.0, bounds, {})
     assert model.in_domain(em.Drivers(**base, bingham=3.0, newtonian=False, plug=0.45))
     assert model.in_domain(em.Drivers(**base))
     assert not model.in_domain(em.Drivers(**base, bingham=7.0, newtonian=False, plug=0.59))
     packaged = em.load_model()
     assert packaged.bounds["bingham_poiseuille"][1] == pytest.approx(10.0)
+
+
+def test_step_on_the_support_radius_bounds_the_domain():
+    """A channel step inside the measured C_Δx range but past the measured δt μ_max/(ρh²) =
+    C_Δx/q² is outside: the 3D Newtonian channel blew up at δt ν/h² = 0.1 (q = 1.6, C_Δx = 0.26)
+    and ran at 0.05 with q = 2.4 (C_Δx = 0.29)."""
+    base = dict(flow="poiseuille", dimension=3, length=4.0, wi=1e-3, units=0.0, n_particles=100,
+                n_steps=100, rows=24)
+    bounds = {"resolution_poiseuille_3d": [1.6, 2.4], "inverse_length_poiseuille": [0.1, 0.5],
+              "wi": [1e-3, 1e-2], "courant_poiseuille_newtonian_3d": [0.1, 0.3],
+              "stepsupport_poiseuille_newtonian_3d": [0.04, 0.068],
+              "bingham_poiseuille": [0.0, 5.0]}
+    model = em.ErrorModel({}, {}, 1.0, bounds, {})
+    assert model.in_domain(em.Drivers(**base, resolution=2.4, courant=0.29))
+    assert model.in_domain(em.Drivers(**base, resolution=1.6, courant=0.17))
+    assert not model.in_domain(em.Drivers(**base, resolution=1.6, courant=0.256))
+    packaged = em.load_model()
+    assert packaged.bounds["stepsupport_poiseuille_newtonian_3d"][1] < 0.1
 
 
 def test_flow_term_per_dimension_falls_back_to_the_largest_measured():

@@ -95,7 +95,12 @@ the very edge of a measured range.
 Domain. The model is used only inside the measured range of each driver
 (``bounds``; C_Δx per flow, dimension and law class, :func:`_step_class`: a viscous-limited
 Papanastasiou Couette run at C_Δx = 0.77 was 44 % off while the Bingham channel, whose μ_max
-= μ(0) is met only in the plug, stayed within 1 % up to C_Δx = 1.5) and on the search grid
+= μ(0) is met only in the plug, stayed within 1 % up to C_Δx = 1.5; and, per class as well,
+the step on the support radius, δt μ_max/(ρh²) = C_Δx/q², the number the viscous operator's
+stability follows: the 3D Newtonian channel blew up at δt ν/h² = 0.1 (q = 1.6, C_Δx = 0.26, Re
+0.1 and 0.25, Wi ≥ 0.003; every candidate of the fourth blind set's Re = 0.25 channel) and ran
+at 0.0675, while q = 2.4 ran at C_Δx = 0.29 with δt ν/h² = 0.05, so C_Δx alone let the picker
+step past the edge) and on the search grid
 (:data:`GRID`), outside which runs blew up or are not measured: q < 1.5 (3D) blew up; q near
 2 (:data:`RESOLUTION_GAP`) gave 5–37 % errors in every training case (lattice shells at
 r = h); a channel with an odd number of rows across L_y (:func:`regular`); quintic blew up at
@@ -183,6 +188,8 @@ MODEL_FILE = "error_model.json"
 #: inflation for every class); the cross-validated inflation keeps format 2 (the same keys).
 FORMAT = 2
 _OBSERVABLE = {"couette": "stress", "poiseuille": "profile"}
+#: Prefixes of the time-step bounds: C_Δx = δt μ_max/(ρΔx²) and δt μ_max/(ρh²) = C_Δx/q².
+_STEP_KEYS = ("courant_", "stepsupport_")
 
 
 @dataclass(frozen=True)
@@ -354,7 +361,7 @@ class ErrorModel:
             return False
         for name, value in _bounded(d).items():
             lo, hi = self._range(name, d.dimension)
-            if name.startswith("courant_") or name == "bingham_poiseuille":
+            if name.startswith(_STEP_KEYS) or name == "bingham_poiseuille":
                 # a smaller step, or a weaker yield stress (Bn = 0: Newtonian), is inside
                 lo = 0.0
             if not lo * (1 - 1e-9) <= value <= hi * (1 + 1e-9):
@@ -370,8 +377,8 @@ class ErrorModel:
         prefix = name.split("_")[0]
         others = [v for k, v in self.bounds.items()
                   if k.startswith(prefix + "_") and k.endswith(f"_{dimension}d")
-                  and prefix in ("resolution", "courant")]
-        if prefix == "courant" and not name.split("_")[2] == "newtonian":
+                  and prefix in ("resolution", "courant", "stepsupport")]
+        if prefix in ("courant", "stepsupport") and not name.split("_")[2] == "newtonian":
             # a rate-dependent law without its own measured range: the tightest
             others = [min(others, key=lambda v: v[1])] if others else []
         if not others:
@@ -431,7 +438,8 @@ def _bounded(d: Drivers) -> dict[str, float]:
     """The drivers whose measured range limits the model, keyed as in ``bounds``."""
     out = {f"resolution_{d.flow}_{d.dimension}d": d.resolution,
            f"inverse_length_{d.flow}": 1 / d.length,
-           "wi": d.wi, f"courant_{_step_class(d)}": d.courant}
+           "wi": d.wi, f"courant_{_step_class(d)}": d.courant,
+           f"stepsupport_{_step_class(d)}": d.courant / d.resolution ** 2}
     if d.units > 0:
         out["units"] = d.units
     if d.flow == "poiseuille":
@@ -644,7 +652,7 @@ def fit_in_sample(points: Sequence[tuple[Drivers, float, float, str]],
             lo, hi = model.bounds.get(name, [math.inf, -math.inf])
             model.bounds[name] = [min(lo, value), max(hi, value)]
     margin = stability_margin([d for d, _ in pairs], failures)
-    model.bounds = {k: ([lo, hi * margin] if k.startswith("courant_") else [lo, hi])
+    model.bounds = {k: ([lo, hi * margin] if k.startswith(_STEP_KEYS) else [lo, hi])
                     for k, (lo, hi) in model.bounds.items()}
     model.cost = fit_cost([(d, cpu) for d, _, cpu in inliers])
     model.provenance = {"unsafe_courant": unsafe, "courant_margin": margin}
