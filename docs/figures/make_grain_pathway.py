@@ -29,7 +29,6 @@ files (default: a temporary directory). One thread per run; prints Markdown and 
 else.
 """
 import argparse
-import json
 import math
 import tempfile
 import time
@@ -53,7 +52,7 @@ from suspsim.sph.inclusions import scene_packing
 from suspsim.sph.simulation import Simulation
 from suspsim.sph.stress import VXY, kinetic_tensor
 from suspsim.validation.flows import couette_viscosity_ratio
-from suspsim.validation.suspension import RATE, HealthWatch, suspension_scene
+from suspsim.validation.suspension import RATE, HealthWatch, parse_overrides, suspension_scene
 
 BOX = 16.875
 RADIUS = 2.5
@@ -228,8 +227,7 @@ def main() -> None:
                         help="a scene key for every run (repeatable)")
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
-    overrides = {key: json.loads(value) for key, value in
-                 (item.split("=", 1) for item in args.set)}
+    overrides = parse_overrides(args.set)
     out = Path(args.out or tempfile.mkdtemp(prefix="grain_pathway_"))
     out.mkdir(parents=True, exist_ok=True)
     settings = "".join(f", {key} = {value}" for key, value in overrides.items())

@@ -17,14 +17,13 @@ sample with the reason, is reported and left out of the means. ``--box`` takes a
 per run; prints a Markdown table and writes nothing else.
 """
 import argparse
-import json
 import math
 import time
 
 import numpy as np
 
 from suspsim.errors import NumericalError
-from suspsim.validation.suspension import RATE, relative_viscosity
+from suspsim.validation.suspension import RATE, parse_overrides, relative_viscosity
 
 BOX = 16.875
 RADIUS = 2.5
@@ -44,8 +43,7 @@ def main() -> None:
                         choices=("sphere", "sand"))
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
-    overrides = {key: json.loads(value) for key, value in
-                 (item.split("=", 1) for item in args.set)}
+    overrides = parse_overrides(args.set)
     means = {}
     settings = "".join(f", {key} = {value}" for key, value in overrides.items())
     print(f"φ = {args.phi}, box {args.box} h, a = {RADIUS} h, μ = 1, γ̇ = {RATE}, strain "

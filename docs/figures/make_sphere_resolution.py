@@ -13,10 +13,9 @@ strain-unit standard error, CPU time, particles) and writes nothing else. ``--se
 scene key for every run (e.g. ``inclusions.lubrication.friction=0.5``).
 """
 import argparse
-import json
 
 from suspsim.rheology.suspension import published_envelope
-from suspsim.validation.suspension import NUMBER_DENSITY, relative_viscosity
+from suspsim.validation.suspension import NUMBER_DENSITY, parse_overrides, relative_viscosity
 
 BOX_PER_RADIUS = 6.0
 SPACING = NUMBER_DENSITY ** (-1.0 / 3.0)
@@ -34,8 +33,7 @@ def main() -> None:
                         help="a scene key for every run (repeatable)")
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
-    overrides = {key: json.loads(value) for key, value in
-                 (item.split("=", 1) for item in args.set)}
+    overrides = parse_overrides(args.set)
     settings = "".join(f", {key} = {value}" for key, value in overrides.items())
     low, high = published_envelope(args.phi)
     print(f"φ = {args.phi} (published envelope {low:.2f}–{high:.2f}), box {BOX_PER_RADIUS:g} a, "

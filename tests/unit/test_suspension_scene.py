@@ -3,7 +3,8 @@ resolution studies): what it asks for is what the scene holds, with the inclusio
 import pytest
 
 from suspsim.scene_rules import AUTO_SHIFTING_WITH_INCLUSIONS
-from suspsim.validation.suspension import NUMBER_DENSITY, RATE, suspension_scene
+from suspsim.validation.suspension import (NUMBER_DENSITY, RATE, parse_overrides,
+                                          suspension_scene)
 
 
 @pytest.mark.parametrize("shape", ["sphere", "sand"])
@@ -28,3 +29,9 @@ def test_overrides_set_dotted_scene_keys_and_keep_the_rest():
     # the siblings of an overridden key keep their values
     assert (scene.inclusions.shape, scene.inclusions.phi) == ("sand", 0.5)
     assert scene.flow.shear_rate == RATE
+
+
+def test_set_items_become_overrides_read_as_json():
+    assert parse_overrides(["run.dt=0.1", 'inclusions.shape="sand"',
+                            "inclusions.lubrication.friction=0.5"]) == {
+        "run.dt": 0.1, "inclusions.shape": "sand", "inclusions.lubrication.friction": 0.5}

@@ -218,7 +218,8 @@ def _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I
         stick = math.sqrt(jfx * jfx + jfy * jfy + jfz * jfz)
         limit = friction * j_rep
         if stick > limit:
-            jfx, jfy, jfz = jfx * limit / stick, jfy * limit / stick, jfz * limit / stick
+            slip = limit / stick
+            jfx, jfy, jfz = jfx * slip, jfy * slip, jfz * slip
         fsx += jfx
         fsy += jfy
         fsz += jfz

@@ -189,7 +189,8 @@ MODEL_FILE = "error_model.json"
 FORMAT = 2
 _OBSERVABLE = {"couette": "stress", "poiseuille": "profile"}
 #: Prefixes of the time-step bounds: C_Δx = δt μ_max/(ρΔx²) and δt μ_max/(ρh²) = C_Δx/q².
-_STEP_KEYS = ("courant_", "stepsupport_")
+_STEP_PREFIXES = ("courant", "stepsupport")
+_STEP_KEYS = tuple(prefix + "_" for prefix in _STEP_PREFIXES)
 
 
 @dataclass(frozen=True)
@@ -377,8 +378,8 @@ class ErrorModel:
         prefix = name.split("_")[0]
         others = [v for k, v in self.bounds.items()
                   if k.startswith(prefix + "_") and k.endswith(f"_{dimension}d")
-                  and prefix in ("resolution", "courant", "stepsupport")]
-        if prefix in ("courant", "stepsupport") and not name.split("_")[2] == "newtonian":
+                  and prefix in ("resolution",) + _STEP_PREFIXES]
+        if prefix in _STEP_PREFIXES and not name.split("_")[2] == "newtonian":
             # a rate-dependent law without its own measured range: the tightest
             others = [min(others, key=lambda v: v[1])] if others else []
         if not others:

@@ -350,10 +350,10 @@ def body_particle_density(pair_start, pair_end, pair_j, geometry, body_of, kerne
     viscosity of the fluid beside it, which a pair of particles of two different bodies uses
     (a fluid–body pair takes the fluid's μ̂ at both ends, ``force_pass``). μ̂_f is the previous
     step's (this step's is computed later from the volumes set here; the normalisation leaves
-    body particles' μ̂ alone); a body particle without fluid neighbours keeps its value. Pairs inside one body have no force (the body moves
-    rigidly) and, with density and μ̂ taken from the fluid, no other use, so the list leaves
-    them out (``group`` of ``neighbours.build_neighbour_list``; a fifth of the pairs within h
-    at φ = 0.4). A body particle's own rate and dissipation factor then come from a one-sided
+    body particles' μ̂ alone); a body particle without fluid neighbours keeps its value. Pairs
+    inside one body have no force (the body moves rigidly) and, with density and μ̂ taken from
+    the fluid, no other use, so the list leaves them out (``group`` of
+    ``neighbours.build_neighbour_list``; a fifth of the pairs within h at φ = 0.4). A body particle's own rate and dissipation factor then come from a one-sided
     neighbourhood, and the shell's inner particles have no neighbours at all.
 
     One sweep of the pair table in the chunks of the density pass (``bounds``; pattern of

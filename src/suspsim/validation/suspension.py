@@ -7,9 +7,10 @@ a relaxed start and the inclusions' defaults.
 """
 from __future__ import annotations
 
+import json
 import math
 import time
-from typing import Any, Mapping, NamedTuple
+from typing import Any, Mapping, NamedTuple, Sequence
 
 import numpy as np
 
@@ -66,6 +67,12 @@ class HealthWatch:
         wall_speed = 0.5 * scene.flow.shear_rate * scene.box[1]
         self.body_speed = max(self.body_speed,
                               float(np.sqrt((peculiar ** 2).sum(axis=1)).max()) / wall_speed)
+
+
+def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """``KEY=VALUE`` strings (a figure script's ``--set``) as :func:`suspension_scene`
+    overrides, each VALUE read as JSON (``run.dt=0.1``, ``inclusions.shape="sand"``)."""
+    return {key: json.loads(value) for key, value in (item.split("=", 1) for item in items)}
 
 
 def suspension_scene(*, shape: str = "sphere", phi: float, radius: float, box: float,
