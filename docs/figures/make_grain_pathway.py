@@ -84,7 +84,7 @@ def compare_particles(spheres: Packing, grains: Packing) -> str:
 
 def step_zero(sphere_sim: Simulation, grain_sim: Simulation) -> str:
     """Pairs, gaps and one lubrication pass of both pathways on the sphere run's first state."""
-    cutoff, min_gap, strength, friction, _, surfaces = grain_sim._lubrication
+    cutoff, min_gap, strength, friction, rolling, _, surfaces = grain_sim._lubrication
     bodies = sphere_sim.bodies
     centres, box = bodies.centres, sphere_sim._box
     radii = sphere_sim._body_radii
@@ -117,15 +117,16 @@ def step_zero(sphere_sim: Simulation, grain_sim: Simulation) -> str:
             sf = surfaces
             grain_lubrication_pass(b.centres, b.rotations(), velocities, omegas, b.mass,
                                    b.moments, box, 0.0, sim._rate, sim.dt, law.code, law.packed,
-                                   cutoff, min_gap, strength, friction, sf.points, sf.normals,
+                                   cutoff, min_gap, strength, friction, rolling, sf.points,
+                                   sf.normals,
                                    sf.first_directions, sf.osculating, sf.principal_curvatures,
                                    sf.tables, sf.to_packing, sf.centroids, sf.reach, virial,
                                    stats)
         else:
             lubrication_pass(b.centres, sim._body_radii, velocities, omegas, b.mass,
                              b.moments.mean(axis=1), box, 0.0, sim._rate, sim.dt, law.code,
-                             law.packed, cutoff, min_gap, strength, friction, virial,
-                             stats)
+                             law.packed, cutoff, min_gap, strength, friction, rolling,
+                             virial, stats)
         scale = float(law.viscosity(sim._rate)) * sim._rate * sim.scene.volume
         virials.append((-virial[VXY] / scale, int(stats[PAIRS]), stats[SMALLEST_GAP]))
     return (f"step 0: pairs within s_c = {cutoff} h: sphere {in_sphere}, grain {in_grain}; "
@@ -139,7 +140,7 @@ def contact_law(grain_sim: Simulation) -> str:
     """At step 0, over the grain pairs within the cutoff gap: the osculating radii R/a and the
     squeeze coefficient c1 (SPEC §3.4) over that of two spheres of the grains' equivalent
     radii, c1 = 6π (a1 a2/(a1 + a2))²: what the grain pathway makes of the shape."""
-    cutoff, _, _, _, _, sf = grain_sim._lubrication
+    cutoff, _, _, _, _, _, sf = grain_sim._lubrication
     b, box, radii = grain_sim.bodies, grain_sim._box, grain_sim._body_radii
     rotations = b.rotations()
     contact = np.zeros(CONTACT_WIDTH)

@@ -118,13 +118,15 @@ class NumericsSpec:
 @dataclass(frozen=True)
 class LubricationSpec:
     """Lubrication between bodies (SPEC §3.3): ``enabled``, ``cutoff_gap`` s_c [h], ``min_gap``
-    s_min [h], ``repulsion`` k [1], ``friction`` μ_c [1] (schema ``inclusions.lubrication``)."""
+    s_min [h], ``repulsion`` k [1], ``friction`` μ_c [1], ``rolling_friction`` μ_r [1] (schema
+    ``inclusions.lubrication``)."""
 
     enabled: bool
     cutoff_gap: float
     min_gap: float
     repulsion: float
     friction: float
+    rolling_friction: float
 
 
 @dataclass(frozen=True)
@@ -248,7 +250,7 @@ def _inclusions(data: Mapping[str, Any]) -> InclusionsSpec:
               for f in fields(InclusionsSpec) if f.name != "lubrication"}
     return InclusionsSpec(**values, lubrication=LubricationSpec(
         bool(lub["enabled"]), float(lub["cutoff_gap"]), float(lub["min_gap"]),
-        float(lub["repulsion"]), float(lub["friction"])))
+        float(lub["repulsion"]), float(lub["friction"]), float(lub["rolling_friction"])))
 
 
 def load_scene(path: str | PathLike) -> Scene:

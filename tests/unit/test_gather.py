@@ -79,7 +79,8 @@ def test_physical_results_of_a_suspension_run_replace_its_simulation_unit_ones()
     assert np.isnan(float(run["particle_radius"]))
     assert json.loads(run.attrs["inclusions"]) == {"shape": "sphere", "radius": 1.0,
                                                    "polydispersity": 0.0, "size_ratio": 5.0,
-                                                   "min_gap": 0.05, "friction": 0.0}
+                                                   "min_gap": 0.05, "friction": 0.0,
+                                                   "rolling_friction": 0.0}
     alone = fake_run(2.0, 3)
     assert alone.attrs["inclusions"] == "" and alone.attrs["inclusion_shape"] == "none"
     assert float(alone["body_count"]) == 0 and np.isnan(float(alone["inclusion_radius"]))

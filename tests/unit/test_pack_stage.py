@@ -1,5 +1,7 @@
 """The pack stage: particle settings from study and material sheet, one study packing, the same
 packing a scene makes for itself, sand through the same path, errors naming the config key."""
+import math
+
 import numpy as np
 import pytest
 
@@ -18,12 +20,13 @@ SMALL = Particles(radius=1.0)
 def test_sheet_overrides_the_study_and_gives_the_physical_radius():
     assert particle_settings(STUDY) == Particles()
     assert particle_settings(STUDY, {"shape": None, "polydispersity": None}) == Particles()
-    merged = particle_settings({**STUDY, "friction": 0.5},
+    merged = particle_settings({**STUDY, "friction": 0.5, "rolling_friction": 0.2},
                                {"shape": "sand", "polydispersity": 0.3, "size_ratio": 3,
-                                "radius_m": 2e-4, "friction": 0.7})
+                                "radius_m": 2e-4, "friction": 0.7, "rolling_friction": None})
     assert merged == Particles(shape="sand", radius=2.5, polydispersity=0.3, size_ratio=3,
-                               physical_radius=2e-4, friction=0.7)
+                               physical_radius=2e-4, friction=0.7, rolling_friction=0.2)
     assert particle_settings({**STUDY, "friction": 0.5}).friction == 0.5
+    assert particle_settings(STUDY, {"rolling_friction": 0.1}).rolling_friction == 0.1
     assert Particles.from_mapping(merged.to_dict()) == merged
 
 
@@ -34,6 +37,8 @@ def test_bad_particle_settings_are_input_errors():
         Particles(physical_radius=0.0)
     with pytest.raises(InputError, match="friction must be >= 0"):
         Particles(friction=-0.1)
+    with pytest.raises(InputError, match="rolling_friction must be >= 0"):
+        Particles(rolling_friction=math.nan)
     with pytest.raises(InputError, match="unknown key"):
         Particles.from_mapping({"radius": 1.0, "colour": "red"})
 

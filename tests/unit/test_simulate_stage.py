@@ -34,12 +34,13 @@ def test_scene_is_a_linear_start_couette_of_the_mapped_law():
 
 def test_scene_above_zero_has_the_inclusions_and_their_reynolds_length():
     particles = Particles(shape="sand", radius=1.2, polydispersity=0.1, physical_radius=3e-5,
-                          friction=0.5)
+                          friction=0.5, rolling_friction=0.1)
     scene, mapping = simulation_scene(LAW, 20.0, volume_fraction=0.2, seed=4, resolution=TINY,
                                       particles=particles, packing="p.nc")
     spec = scene.inclusions
     assert spec.present and spec.packing == "p.nc" and spec.phi == 0.2 and spec.seed == 4
     assert spec.lubrication.friction == 0.5 and spec.lubrication.enabled
+    assert spec.lubrication.rolling_friction == 0.1
     assert (spec.shape, spec.radius, spec.polydispersity) == ("sand", 1.2, 0.1)
     mu_sim = float(scene.fluid.law.viscosity(scene.flow.shear_rate))
     # SPEC §7: at φ > 0 the particle Reynolds number takes the inclusion radius as its length.

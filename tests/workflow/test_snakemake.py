@@ -209,7 +209,8 @@ def test_friction_reruns_the_suspension_runs_but_not_their_packings(tmp_path):
     study = _study(tmp_path, {"linear_polymer": REPO / "data/linear_polymer/matrix.csv"})
     spheres = ["--configfile", "config/studies/spheres.yaml"]
     _placeholders(study, *spheres)
-    (study / "data/linear_polymer/material.yaml").write_text("particles: {friction: 0.5}\n")
+    (study / "data/linear_polymer/material.yaml").write_text(
+        "particles: {friction: 0.5, rolling_friction: 0.1}\n")
     dry = _run(study, "-n", *spheres)
     config = yaml.safe_load((study / "config/studies/spheres.yaml").read_text())["simulation"]
     suspensions = (sum(phi > 0 for phi in config["volume_fractions"])

@@ -10,7 +10,7 @@ from suspsim.errors import SuspsimError
 from suspsim.io.provenance import code_version
 from suspsim.rheology.readers import read_flow_curve
 from suspsim.scene_rules import lattice_mismatch
-from suspsim.stages.pack import particle_settings
+from suspsim.stages.pack import CONTACT_KEYS, particle_settings
 
 
 validate(config, "../schemas/config.schema.yaml")
@@ -158,9 +158,9 @@ def run_particles(wildcards):
 
 def pack_particles(wildcards):
     """The material's particle settings that shape its packings (the physical radius and the
-    friction do not)."""
+    contacts' friction do not)."""
     return {k: v for k, v in PARTICLES[wildcards.material].items()
-            if k not in ("physical_radius", "friction")}
+            if k != "physical_radius" and k not in CONTACT_KEYS}
 
 
 def run_shear_rate(wildcards):

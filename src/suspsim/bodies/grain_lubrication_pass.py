@@ -73,7 +73,8 @@ def _lever_mobility(lx, ly, lz, dx, dy, dz, inv_inertia):
 @njit(**JIT_OPTIONS)
 def grain_pair_impulse(contact, r12, v1, v2, w1, w2, mass1, mass2, inv_inertia1, inv_inertia2,
                        scalar1, scalar2, e1a, k1a, k2a, e1b, k1b, k2b, dt, law_code, law_params,
-                       cutoff_gap, min_gap, repulsion_strength, friction, out):
+                       cutoff_gap, min_gap, repulsion_strength, friction, rolling_friction,
+                       out):
     """Impulses on two grains from their contact record (``contact``,
     :func:`~suspsim.bodies.grain_contacts.grain_pair_contact`; module docstring).
 
@@ -111,7 +112,8 @@ def grain_pair_impulse(contact, r12, v1, v2, w1, w2, mass1, mass2, inv_inertia1,
     zero = np.zeros(3)
     s_new = lubrication_pair_impulse_law(ra, rb, rv, u1, u2, w1, w2, zero, zero, zero, zero, m1,
                                          m2, scalar1, scalar2, dt, mu, c1, c2, c3, ell,
-                                         cutoff_gap, min_gap, repulsion_strength, friction, out)
+                                         cutoff_gap, min_gap, repulsion_strength, friction,
+                                         rolling_friction, out)
     # angular impulses about the centres of mass: L + ℓ × J
     jx, jy, jz = out[0, 0], out[0, 1], out[0, 2]
     out[2, 0] += lay * jz - laz * jy
@@ -126,9 +128,9 @@ def grain_pair_impulse(contact, r12, v1, v2, w1, w2, mass1, mass2, inv_inertia1,
 @njit(**JIT_OPTIONS)
 def grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments, box, le_offset,
                            shear_rate, dt, law_code, law_params, cutoff_gap, min_gap,
-                           repulsion_strength, friction, points, normals, first_directions,
-                           osculating, principal_curvatures, tables, to_packing, centroids, reach,
-                           virial, stats):
+                           repulsion_strength, friction, rolling_friction, points, normals,
+                           first_directions, osculating, principal_curvatures, tables,
+                           to_packing, centroids, reach, virial, stats):
     """Apply the impulses of every grain pair whose closest-point gap is below ``cutoff_gap``
     to ``velocities`` and ``omegas`` (B, 3) in place (module docstring).
 
@@ -191,7 +193,8 @@ def grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments
                                        principal_curvatures[p, ka, 1], e1b,
                                        principal_curvatures[q, kb, 0],
                                        principal_curvatures[q, kb, 1], dt, law_code, law_params,
-                                       cutoff_gap, min_gap, repulsion_strength, friction, out)
+                                       cutoff_gap, min_gap, repulsion_strength, friction,
+                                       rolling_friction, out)
             for k in range(3):
                 velocities[p, k] += out[0, k] / mass[p]
                 velocities[q, k] += out[1, k] / mass[q]

@@ -12,8 +12,8 @@ drawn from the caller's :class:`numpy.random.Generator`:
    a_n0 = A_n cos ψ_n0 and (a_nm, a_n,−m) = A_n (cos ψ_nm, sin ψ_nm) for m > 0, an isotropic
    random field. The exponent p = ``spectral_exponent`` = 2.2 [choice: 2D sand outlines have a
    power spectrum ∝ n^(−10/3); |a_nm| ∼ n^(−2.2) is the 3D estimate of SPEC §4]. Its
-   root-mean-square over the sphere is ``roughness`` [choice, default 0.05 of the equivalent
-   radius: rounded to subangular grains];
+   root-mean-square over the sphere is ``roughness`` [choice, default 0.02 of the equivalent
+   radius: rounded grains];
 3. elongation L/W drawn uniformly from ``elongation_range`` [choice, (1.2, 1.6): natural sands,
    to be checked against measured shapes] and met exactly by adjusting a/b (Brent's method),
    flatness W/T ≈ b/c drawn uniformly from the same range [choice]. L ≥ W ≥ T are the extents

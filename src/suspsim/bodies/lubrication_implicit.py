@@ -39,6 +39,17 @@ lever arms) if that needs no more than μ_c j_rep (stick, J_f = −σ'/W_σσ); 
 repulsion does not reach feel no friction. The split (lubrication, then friction on its result)
 is first order in δt and stable at any step: the friction impulse only removes sliding.
 
+**Rolling friction** [choice, not in SPEC; the rolling resistance by which DEM represents the
+shape of grains, Wensrich & Katterfeld, Powder Technol. 217, 409 (2012); in suspensions, rolling
+constraints lower the jamming fraction of rough or faceted particles, Sharma, Sharma & Singh,
+arXiv:2505.22747 (2025)]. With a coefficient μ_r > 0 the relative rolling ρ = (Ω₁ − Ω₂) × d
+left after lubrication and sliding friction is stopped the same way by an angular impulse pair
+±d × J_r (a generalized rolling force, so ρ changes by W_ρρ J_r and σ by W_σρ J_r): stick
+J_r = −ρ/W_ρρ if |J_r| ≤ μ_r R_eff j_rep (R_eff = a1 a2/(a1 + a2)), else slip at that limit, the
+constant-torque rolling resistance of Ai, Chen, Rotter & Ooi, Powder Technol. 206, 269 (2011).
+Each of the two impulses is a fraction α ≤ 1 of the one that stops its own mode, so each
+changes the kinetic energy by (α²/2 − α) y²/W ≤ 0; neither has a net force or torque.
+
 Assumptions: positions are frozen at the start of the step (d, κ, s for the tangential modes);
 the viscosity ``mu`` is supplied by the caller (lagged, e.g. :func:`gap_viscosity` at the
 predicted velocities); the integrator moves positions by δt × the corrected velocities; pairs are
@@ -113,9 +124,10 @@ def implicit_normal_gap(s, x_star, w, dt, mu, c1, c2, c3, ell, cutoff_gap, min_g
 
 @njit(**JIT_OPTIONS)
 def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2,
-                             dt, mu, cutoff_gap, min_gap, repulsion_strength, friction, out):
-    """Implicit lubrication + repulsion (+ contact friction) impulses of a sphere pair over one
-    step.
+                             dt, mu, cutoff_gap, min_gap, repulsion_strength, friction,
+                             rolling_friction, out):
+    """Implicit lubrication, repulsion, contact and rolling friction impulses of a sphere pair
+    over one step.
 
     Inputs: radii a1, a2 [h]; ``r12`` = x1 − x2 [h] at the start of the step; velocities U1, U2
     [h τ⁻¹] and angular velocities W1, W2 [τ⁻¹] before the update; dU1, dU2, dW1, dW2 their
@@ -124,7 +136,8 @@ def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1
     viscosity; ``cutoff_gap``, ``min_gap``, ``repulsion_strength`` as in
     :func:`~suspsim.bodies.lubrication.lubrication_pair_force` and
     :func:`~suspsim.bodies.lubrication.repulsion_force`; ``friction`` the Coulomb coefficient
-    μ_c [1] of the contact the repulsion stands for (module docstring; 0: frictionless).
+    μ_c [1] of the contact the repulsion stands for and ``rolling_friction`` its rolling
+    resistance μ_r [1] (module docstring; 0: frictionless).
 
     Writes ``out`` (4, 3): rows J1, J2 (impulses on 1 and 2, J2 = −J1) and L1, L2 (angular
     impulses); the new velocities are U + dU + J/m, Ω + dΩ + L/I. Returns the predicted gap at
@@ -134,13 +147,13 @@ def lubrication_pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1
     c1, c2, c3, ell = sphere_squeeze_law(a1, a2)
     return _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt,
                          mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, friction,
-                         out)
+                         rolling_friction, out)
 
 
 @njit(**JIT_OPTIONS)
 def lubrication_pair_impulse_law(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1,
                                  I2, dt, mu, c1, c2, c3, ell, cutoff_gap, min_gap,
-                                 repulsion_strength, friction, out):
+                                 repulsion_strength, friction, rolling_friction, out):
     """:func:`lubrication_pair_impulse` with the normal law (c1, c2, c3, ℓ) of
     :func:`~suspsim.bodies.lubrication.normal_resistance` given: e.g. c1 from the curvatures
     of two non-spherical surfaces (SPEC §3.4,
@@ -149,12 +162,25 @@ def lubrication_pair_impulse_law(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2
     tangential and twist modes are those of the spheres a1, a2."""
     return _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt,
                          mu, c1, c2, c3, ell, cutoff_gap, min_gap, repulsion_strength, friction,
-                         out)
+                         rolling_friction, out)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def _stop_within(yx, yy, yz, mobility, limit):
+    """Impulse −y/W that stops a mode of velocity y and mobility W, scaled down to length
+    ``limit`` if longer (Coulomb stick or slip; module docstring)."""
+    jx, jy, jz = -yx / mobility, -yy / mobility, -yz / mobility
+    stick = math.sqrt(jx * jx + jy * jy + jz * jz)
+    if stick > limit:
+        slip = limit / stick
+        jx, jy, jz = jx * slip, jy * slip, jz * slip
+    return jx, jy, jz
 
 
 @njit(inline="always", **JIT_OPTIONS)
 def _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I2, dt, mu, c1, c2,
-                  c3, ell, cutoff_gap, min_gap, repulsion_strength, friction, out):
+                  c3, ell, cutoff_gap, min_gap, repulsion_strength, friction, rolling_friction,
+                  out):
     dx, dy, dz, s, kap = _pair_geometry(a1, a2, r12)
     out[:, :] = 0.0
     v1x, v1y, v1z = U1[0] + dU1[0], U1[1] + dU1[1], U1[2] + dU1[2]
@@ -214,15 +240,20 @@ def _pair_impulse(a1, a2, r12, U1, U2, W1, W2, dU1, dU2, dW1, dW2, m1, m2, I1, I
     frz = -dt * (k_sr * nsz + k_rr * nrz)
     if friction > 0.0 and j_rep > 0.0:
         # Coulomb contact: stop the sliding left after lubrication, within μ_c j_rep
-        jfx, jfy, jfz = -nsx / w_ss, -nsy / w_ss, -nsz / w_ss
-        stick = math.sqrt(jfx * jfx + jfy * jfy + jfz * jfz)
-        limit = friction * j_rep
-        if stick > limit:
-            slip = limit / stick
-            jfx, jfy, jfz = jfx * slip, jfy * slip, jfz * slip
+        jfx, jfy, jfz = _stop_within(nsx, nsy, nsz, w_ss, friction * j_rep)
         fsx += jfx
         fsy += jfy
         fsz += jfz
+        nrx += w_sr * jfx
+        nry += w_sr * jfy
+        nrz += w_sr * jfz
+    if rolling_friction > 0.0 and j_rep > 0.0:
+        # rolling resistance: stop the rolling left, within μ_r R_eff j_rep
+        jrx, jry, jrz = _stop_within(nrx, nry, nrz, w_rr,
+                                     rolling_friction * a1 * a2 / (a1 + a2) * j_rep)
+        frx += jrx
+        fry += jry
+        frz += jrz
     k_t = mu * m_t
     jt = -dt * k_t * wn / (1.0 + dt * k_t * w_rr)
     out[0, 0] = fsx - jn * dx

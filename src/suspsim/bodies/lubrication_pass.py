@@ -4,10 +4,10 @@ After the fluid forces have kicked the bodies, every pair of bodies whose surfac
 below the cutoff s_c gets the implicit lubrication and repulsion impulses of
 :func:`~suspsim.bodies.lubrication_implicit.lubrication_pair_impulse` (SPEC §3.3: the
 correction F_lub(s) − F_lub(s_c), the inner cap s_min, the repulsion C/s⁸, the contact friction
-μ_c), applied to the
-velocities pair after pair — the order the implicit step requires when a body has several
-close neighbours. Pairs are found among all B(B − 1)/2 with the Lees–Edwards minimum image of
-the centres (SPEC §2.7): the image of body 2 one box height up moves γ̇ L_y faster in x.
+μ_c and rolling friction μ_r), applied to the velocities pair after pair — the order the
+implicit step requires when a body has several close neighbours. Pairs are found among all
+B(B − 1)/2 with the Lees–Edwards minimum image of the centres (SPEC §2.7): the image of body 2
+one box height up moves γ̇ L_y faster in x.
 
 The viscosity of each gap is the matrix law at the gap shear rate (seed 000's heuristic,
 :func:`~suspsim.bodies.lubrication.gap_viscosity`). The bodies are spheres, with the scalar
@@ -39,7 +39,7 @@ SMALLEST_GAP, PAIRS, OVERLAPS = range(3)
 @njit(**JIT_OPTIONS)
 def lubrication_pass(centres, radii, velocities, omegas, mass, inertia, box, le_offset,
                      shear_rate, dt, law_code, law_params, cutoff_gap, min_gap,
-                     repulsion_strength, friction, virial, stats):
+                     repulsion_strength, friction, rolling_friction, virial, stats):
     """Apply the impulses of every pair with s < ``cutoff_gap`` to ``velocities`` and
     ``omegas`` (B, 3) in place; ``virial`` (5,) gets Σ F₁₂ ⊗ r₁₂ (module docstring);
     ``stats`` (3,) the smallest gap, the number of pairs and of predicted overlaps."""
@@ -72,7 +72,7 @@ def lubrication_pass(centres, radii, velocities, omegas, mass, inertia, box, le_
                                              omegas[p], omegas[q], zero, zero, zero, zero,
                                              mass[p], mass[q], inertia[p], inertia[q], dt, mu,
                                              cutoff_gap, min_gap, repulsion_strength, friction,
-                                             out)
+                                             rolling_friction, out)
             for k in range(3):
                 velocities[p, k] += out[0, k] / mass[p]
                 velocities[q, k] += out[1, k] / mass[q]

@@ -393,9 +393,9 @@ class Simulation:
         return forces, torques
 
     def _lubrication_setup(self):
-        """(s_c, s_min, repulsion C, friction μ_c, scalar inertia, grain surfaces or None) or None
-        (``inclusions.lubrication``): C = k μ(γ̇) γ̇ ā² s_min⁸ with ā the bodies' mean radius;
-        grains get their surface samples (``bodies.grain_contacts``)."""
+        """(s_c, s_min, repulsion C, friction μ_c, rolling friction μ_r, scalar inertia, grain
+        surfaces or None) or None (``inclusions.lubrication``): C = k μ(γ̇) γ̇ ā² s_min⁸ with ā
+        the bodies' mean radius; grains get their surface samples (``bodies.grain_contacts``)."""
         spec = self.scene.inclusions.lubrication
         if self.bodies is None or not spec.enabled:
             return None
@@ -407,7 +407,7 @@ class Simulation:
             g = self._grains
             surfaces = grain_surfaces(g["coefficients"], self._body_radii, g["support_radii"],
                                       g["centre_shift"], g["body_to_principal"])
-        return (spec.cutoff_gap, spec.min_gap, strength, spec.friction,
+        return (spec.cutoff_gap, spec.min_gap, strength, spec.friction, spec.rolling_friction,
                 self.bodies.moments.mean(axis=1), surfaces)
 
     def _lubricate(self, time: float, rotations) -> None:
@@ -415,21 +415,22 @@ class Simulation:
         grains at their closest points, ``bodies.grain_lubrication_pass``, with ``rotations``
         the step's orientations (B, 3, 3))."""
         bodies, law = self.bodies, self.scene.fluid.law
-        cutoff, min_gap, strength, friction, inertia, surfaces = self._lubrication
+        cutoff, min_gap, strength, friction, rolling, inertia, surfaces = self._lubrication
         omegas = bodies.angular_velocities()
         if surfaces is None:
             lubrication_pass(bodies.centres, self._body_radii, bodies.velocities, omegas,
                              bodies.mass, inertia, self._box, self._offset(time), self._rate,
                              self.dt, law.code, law.packed, cutoff, min_gap, strength,
-                             friction, self._lubrication_virial, self._lubrication_stats)
+                             friction, rolling, self._lubrication_virial,
+                             self._lubrication_stats)
         else:
             sf = surfaces
             grain_lubrication_pass(bodies.centres, rotations, bodies.velocities, omegas,
                                    bodies.mass, bodies.moments, self._box, self._offset(time),
                                    self._rate, self.dt, law.code, law.packed, cutoff, min_gap,
-                                   strength, friction, sf.points, sf.normals, sf.first_directions,
-                                   sf.osculating, sf.principal_curvatures, sf.tables,
-                                   sf.to_packing, sf.centroids, sf.reach,
+                                   strength, friction, rolling, sf.points, sf.normals,
+                                   sf.first_directions, sf.osculating, sf.principal_curvatures,
+                                   sf.tables, sf.to_packing, sf.centroids, sf.reach,
                                    self._lubrication_virial, self._lubrication_stats)
         bodies.set_angular_velocities(omegas)
 

@@ -9,7 +9,8 @@ standard errors [Pa s, 1], the matrix viscosity of the fitted law [Pa s], wall t
 resolution (particles, box side, number density, strain), Re, Mach and the unit scales (SPEC §7),
 and the inclusions' radius [h], packing seed, body count and physical radius [m] (NaN at φ = 0).
 The inclusion settings every run with inclusions shares (shape, radius, polydispersity, size
-ratio, gap, friction) become the attributes ``inclusions`` (JSON) and ``inclusion_shape``.
+ratio, gap, friction, rolling friction) become the attributes ``inclusions`` (JSON) and
+``inclusion_shape``.
 
 Summary statistics over seeds (mean and spread) belong to the reader; the summary keeps every run.
 """

@@ -32,6 +32,10 @@ log = logging.getLogger(__name__)
 STUDY_MIN_GAP = float(load_schema("scene")["properties"]["inclusions"]["properties"]
                       ["min_gap"]["default"])
 
+#: Particle settings of the contacts (the scene's ``inclusions.lubrication`` keys of the same
+#: names): they set the runs, not the packings.
+CONTACT_KEYS = ("friction", "rolling_friction")
+
 #: The study's config key (or material-sheet key) behind each argument of the packer, for
 #: error messages.
 CONFIG_KEYS = {"box": "simulation.box", "volume_fraction": "simulation.volume_fractions",
@@ -52,7 +56,8 @@ class Particles:
     radii [1]; ``size_ratio`` largest/smallest radius bound [1]; ``physical_radius`` the
     particles' mean radius [m] when the material sheet gives it (it sets the length scale
     physical_radius/radius [m per h]), else None; ``friction`` the Coulomb coefficient of their
-    contacts [1] (the scene's ``inclusions.lubrication.friction``; it does not shape packings).
+    contacts [1] and ``rolling_friction`` their rolling resistance [1] (the scene's
+    ``inclusions.lubrication.friction`` and ``rolling_friction``; they do not shape packings).
     """
 
     shape: str = "sphere"
@@ -61,6 +66,7 @@ class Particles:
     size_ratio: float = 5.0
     physical_radius: float | None = None
     friction: float = 0.0
+    rolling_friction: float = 0.0
 
     def __post_init__(self):
         if self.shape not in SHAPES:
@@ -70,8 +76,10 @@ class Particles:
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value > 0):
                 raise InputError("particles", f"{name} must be positive, got {value!r}")
-        if not (math.isfinite(self.friction) and self.friction >= 0):
-            raise InputError("particles", f"friction must be >= 0, got {self.friction!r}")
+        for name in CONTACT_KEYS:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise InputError("particles", f"{name} must be >= 0, got {value!r}")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-able values (a Snakemake param, a netCDF attribute)."""
@@ -90,13 +98,13 @@ def particle_settings(study: Mapping[str, Any],
                       sheet: Mapping[str, Any] | None = None) -> Particles:
     """The study's ``simulation.inclusions`` block, overridden by a material sheet's
     ``particles`` block (keys ``shape``, ``polydispersity``, ``size_ratio``, ``friction``,
-    ``radius_m``)."""
+    ``rolling_friction``, ``radius_m``)."""
     sheet = sheet or {}
-    values = {name: study[name] for name in ("shape", "radius", "polydispersity", "size_ratio",
-                                             "friction")
+    values = {name: study[name]
+              for name in ("shape", "radius", "polydispersity", "size_ratio") + CONTACT_KEYS
               if name in study}
-    values.update({name: sheet[name] for name in ("shape", "polydispersity", "size_ratio",
-                                                  "friction")
+    values.update({name: sheet[name]
+                   for name in ("shape", "polydispersity", "size_ratio") + CONTACT_KEYS
                    if sheet.get(name) is not None})
     if sheet.get("radius_m") is not None:
         values["physical_radius"] = float(sheet["radius_m"])

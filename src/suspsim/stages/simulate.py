@@ -45,7 +45,7 @@ from ..rheology.laws import ConstitutiveLaw, make_law
 from ..run import checkpoint_path, run_scene
 from ..scene import Scene, scene_from_dict
 from ..units import DEFAULT_REYNOLDS, UnitMapping, unit_mapping
-from .pack import STUDY_MIN_GAP, Particles
+from .pack import CONTACT_KEYS, STUDY_MIN_GAP, Particles
 
 log = logging.getLogger(__name__)
 
@@ -148,7 +148,8 @@ def simulation_scene(law: ConstitutiveLaw, shear_rate: float, *, volume_fraction
                           polydispersity=particles.polydispersity,
                           size_ratio=particles.size_ratio, min_gap=STUDY_MIN_GAP,
                           seed=int(seed), packing=None if packing is None else str(packing),
-                          lubrication={"friction": particles.friction})
+                          lubrication={name: getattr(particles, name)
+                                       for name in CONTACT_KEYS})
     data = {"dimension": 3, "box": [resolution.box] * 3,
             "number_density": resolution.number_density,
             "fluid": {"law": sim_law.name, "params": dict(sim_law.params)},
@@ -293,7 +294,7 @@ def with_physical_results(run: xr.Dataset, mapping: UnitMapping, *, scene: Scene
     out.attrs["resolution"] = json.dumps(asdict(resolution))
     settings = {name: value for name, value in asdict(spec).items()
                 if name in ("shape", "radius", "polydispersity", "size_ratio", "min_gap")}
-    settings["friction"] = spec.lubrication.friction
+    settings.update({name: getattr(spec.lubrication, name) for name in CONTACT_KEYS})
     if spec.present and mapping.length_scale is not None:
         settings["physical_radius"] = spec.radius * mapping.length_scale
     out.attrs["inclusions"] = json.dumps(settings) if spec.present else ""

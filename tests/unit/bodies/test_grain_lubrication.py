@@ -40,7 +40,7 @@ def _run_pass(surfaces, centres, rotations, velocities, omegas, mass, moments, s
     virial, stats = np.zeros(5), np.zeros(3)
     sf = surfaces
     grain_lubrication_pass(centres, rotations, velocities, omegas, mass, moments, BOX, 0.0, 0.0,
-                           dt, law.code, law.packed, cutoff, min_gap, strength, 0.0, sf.points,
+                           dt, law.code, law.packed, cutoff, min_gap, strength, 0.0, 0.0, sf.points,
                            sf.normals, sf.first_directions, sf.osculating,
                            sf.principal_curvatures, sf.tables, sf.to_packing, sf.centroids,
                            sf.reach, virial, stats)
@@ -116,7 +116,7 @@ def test_two_spheres_through_the_grain_path_reproduce_the_sphere_path():
     want_v, want_w = velocities.copy(), omegas.copy()
     virial, stats = np.zeros(5), np.zeros(3)
     lubrication_pass(centres, radii, want_v, want_w, mass, moments[:, 0], BOX, 0.0, 0.0, 0.05,
-                     law.code, law.packed, CUTOFF, MIN_GAP, strength, 0.0, virial, stats)
+                     law.code, law.packed, CUTOFF, MIN_GAP, strength, 0.0, 0.0, virial, stats)
     assert stats[PAIRS] == 1 and got[3][PAIRS] == 1
     assert got[3][SMALLEST_GAP] == pytest.approx(stats[SMALLEST_GAP], abs=1e-9)
     # the change of each velocity is the impulse; compare those, to round-off
@@ -160,7 +160,7 @@ def test_elongated_grains_side_by_side_have_their_true_gap():
     sphere_stats = np.zeros(3)
     lubrication_pass(centres, np.full(2, 2.5), still.copy(), still.copy(), mass, moments[:, 0],
                      BOX, 0.0, 0.0, 0.05, law.code, law.packed, CUTOFF, MIN_GAP, strength,
-                     0.0, np.zeros(5), sphere_stats)
+                     0.0, 0.0, np.zeros(5), sphere_stats)
     assert sphere_stats[SMALLEST_GAP] < 0.0  # the defect this replaces
 
 

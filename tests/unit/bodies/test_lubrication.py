@@ -350,7 +350,7 @@ def drive_pair(steps, repulsion, implicit=True, s0=S0, cutoff=CUTOFF):
         if implicit:
             lubrication_pair_impulse(A, A, x1 - x2, u1, u2, w1, w2, du1, du2, np.zeros(3),
                                      np.zeros(3), MASS, MASS, inertia, inertia, DT, MU, cutoff,
-                                     MIN_GAP, repulsion, 0.0, out)
+                                     MIN_GAP, repulsion, 0.0, 0.0, out)
             u1, u2 = u1 + du1 + out[0] / MASS, u2 + du2 + out[1] / MASS
         else:
             s = lub.lubrication_pair_force(A, A, x1 - x2, u1, u2, w1, w2, MU, cutoff, MIN_GAP, out)
@@ -431,7 +431,7 @@ def test_implicit_tangential_modes_equal_dense_backward_euler():
     du2 += ((u1 + du1 - u2 - du2) @ d) * d                # zero relative normal velocity
     out = np.zeros((4, 3))
     s_new = lubrication_pair_impulse(a1, a2, r12, u1, u2, w1, w2, du1, du2, dw1, dw2, m1, m2,
-                                     i1, i2, dt, mu, 0.3, 1e-4, 0.0, 0.0, out)
+                                     i1, i2, dt, mu, 0.3, 1e-4, 0.0, 0.0, 0.0, out)
     assert s_new == pytest.approx(s, rel=1e-12)
     mass = np.diag(np.repeat([m1, m2, i1, i2], 3))
     v_star = np.concatenate([u1 + du1, u2 + du2, w1 + dw1, w2 + dw2])
@@ -452,7 +452,7 @@ def test_implicit_impulses_conserve_momentum_and_dissipate():
         r12 = pair_r12(a1, a2, 0.02, rng.normal(size=3))
         v = rng.normal(size=(4, 3))
         lubrication_pair_impulse(a1, a2, r12, v[0], v[1], v[2], v[3], *np.zeros((4, 3)), m1, m2,
-                                 i1, i2, dt, 1.0, 0.3, 1e-4, 1e-22, 0.0, out)
+                                 i1, i2, dt, 1.0, 0.3, 1e-4, 1e-22, 0.0, 0.0, out)
         scale = np.abs(out).max()
         assert scale > 0
         assert np.allclose(out[0], -out[1], rtol=0, atol=1e-14 * scale)
@@ -478,12 +478,12 @@ def _pressed_pair(rng, s=0.06):
     return a1, a2, r12, v, (0.3, 0.1), (0.4 * 0.3, 0.4 * 0.1 * 0.49), 0.01, 0.3, 0.05, 1e-9
 
 
-def _impulse(pair, friction, repulsion=None):
+def _impulse(pair, friction, repulsion=None, rolling=0.0):
     a1, a2, r12, v, (m1, m2), (i1, i2), dt, cutoff, min_gap, c = pair
     out = np.zeros((4, 3))
     lubrication_pair_impulse(a1, a2, r12, v[0], v[1], v[2], v[3], *np.zeros((4, 3)), m1, m2, i1,
                              i2, dt, 1.0, cutoff, min_gap, c if repulsion is None else repulsion,
-                             friction, out)
+                             friction, rolling, out)
     return out
 
 
@@ -530,20 +530,62 @@ def test_friction_sticks_within_its_cone_and_slips_at_its_limit():
         assert extra @ slide < 0
 
 
-def test_friction_conserves_momentum_removes_energy_and_needs_a_contact():
+def _rolling(pair, out):
+    """Relative rolling (Ω₁ − Ω₂) × d after the impulses ``out``."""
+    a1, a2, r12, v, _, (i1, i2), *_ = pair
+    d = -r12 / np.linalg.norm(r12)
+    return np.cross(v[2] + out[2] / i1 - v[3] - out[3] / i2, d)
+
+
+def test_rolling_friction_sticks_and_slips_at_its_torque_limit():
+    """Stick: a large μ_r leaves no relative rolling. Slip: a small μ_r adds only an angular
+    impulse pair ±d × J_r with |J_r| = μ_r R_eff j_rep, against the rolling left; the linear
+    impulses are those of sliding friction alone."""
+    rng = np.random.default_rng(47)
+    for friction in (0.0, 0.3):
+        pair = _pressed_pair(rng)
+        a1, a2, r12 = pair[:3]
+        d = -r12 / np.linalg.norm(r12)
+        r_eff = a1 * a2 / (a1 + a2)
+        j_rep = _repulsion_impulse(pair)
+        plain = _impulse(pair, friction)
+        roll = _rolling(pair, plain)
+        assert np.linalg.norm(roll) > 1e-3
+        stuck = _impulse(pair, friction, rolling=1e6)
+        assert np.linalg.norm(_rolling(pair, stuck)) <= 1e-10 * np.linalg.norm(roll)
+        mu_r = 1e-3 * np.linalg.norm(roll) * pair[5][0] / (r_eff * j_rep)
+        slip = _impulse(pair, friction, rolling=mu_r)
+        assert np.array_equal(slip[:2], plain[:2])
+        extra1, extra2 = slip[2] - plain[2], slip[3] - plain[3]
+        noise = 1e-13 * np.abs(slip[2:]).max()          # round-off of the differences
+        assert np.allclose(extra1, -extra2, rtol=0, atol=noise)
+        assert abs(extra1 @ d) <= noise
+        j_r = np.cross(extra1, d)                       # d × J_r, J_r ⟂ d
+        assert np.linalg.norm(j_r) == pytest.approx(mu_r * r_eff * j_rep, abs=noise)
+        assert np.linalg.norm(j_r) > 1e3 * noise
+        assert j_r @ roll < 0
+
+
+@pytest.mark.parametrize("base,added", [
+    ((0.0, 0.0), [(0.1, 0.0), (1.0, 0.0), (1e6, 0.0)]),        # sliding friction
+    ((0.4, 0.0), [(0.4, 0.05), (0.4, 0.5), (0.4, 1e6)]),       # rolling on top of it
+])
+def test_friction_conserves_momentum_removes_energy_and_needs_a_contact(base, added):
+    """Each friction (μ_c, μ_r) added to ``base`` keeps J₂ = −J₁ and the angular momentum,
+    lowers the kinetic energy, and changes nothing where the repulsion does not act."""
     rng = np.random.default_rng(43)
-    for friction in (0.1, 1.0, 1e6):
+    for friction, rolling in added:
         pair = _pressed_pair(rng)
         a1, a2, r12, v, (m1, m2), (i1, i2), *_ = pair
-        out = _impulse(pair, friction)
+        before = _impulse(pair, base[0], rolling=base[1])
+        out = _impulse(pair, friction, rolling=rolling)
         scale = np.abs(out).max()
         assert np.allclose(out[0], -out[1], rtol=0, atol=1e-14 * scale)
         assert np.abs(out[2] + out[3] + np.cross(r12, out[0])).max() <= 1e-12 * scale
         mass = np.array([m1, m2, i1, i2])[:, None]
-        energy = [0.5 * np.sum(mass * (v + o / mass) ** 2) for o in (_impulse(pair, 0.0), out)]
+        energy = [0.5 * np.sum(mass * (v + o / mass) ** 2) for o in (before, out)]
         assert energy[1] < energy[0]
-        # no repulsion, no contact: friction changes nothing
-        assert np.array_equal(_impulse(pair, friction, repulsion=0.0),
+        assert np.array_equal(_impulse(pair, friction, repulsion=0.0, rolling=rolling),
                               _impulse(pair, 0.0, repulsion=0.0))
 
 
