@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from suspsim.errors import InputError
-from suspsim.io import checkpoint
 from suspsim.io.checkpoint import graceful_interrupt, load_checkpoint, save_checkpoint, scene_hash
 from suspsim.scene import scene_from_dict
 

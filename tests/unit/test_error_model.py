@@ -1,5 +1,6 @@
-"""The error model, cost model and tolerance picker (suspsim.convergence.error_model) and the
-tolerance set-up of `suspsim run --tolerance` (suspsim.convergence.tolerance)."""
+"""The error model, its fit and cost model, the tolerance picker (suspsim.convergence.error_model,
+error_fit, picker) and the tolerance set-up of `suspsim run --tolerance`
+(suspsim.convergence.tolerance)."""
 import json
 import math
 from pathlib import Path
@@ -9,7 +10,9 @@ import pytest
 
 import suspsim.run as run_module
 from suspsim.cli import main
+from suspsim.convergence import error_fit as ef
 from suspsim.convergence import error_model as em
+from suspsim.convergence import picker as pk
 from suspsim.convergence.cases import get_case
 from suspsim.convergence.tolerance import choose, scene_case
 from suspsim.errors import InputError
@@ -40,17 +43,17 @@ def synthetic_points(rng):
 
 def test_fit_recovers_known_coefficients():
     points = synthetic_points(np.random.default_rng(1))
-    coef, loss = em.fit_coefficients(points, EXPONENTS)
+    coef, loss = ef.fit_coefficients(points, EXPONENTS)
     assert loss < 1e-20
     for name, value in TRUE.items():
         assert coef[name] == pytest.approx(value, rel=1e-6, abs=1e-12), name
 
 
 def test_exponent_search_finds_the_true_exponents(monkeypatch):
-    monkeypatch.setattr(em, "EXPONENTS", {"p_2d": (2.0,), "p_3d": (1.0, 1.5, 3.0),
+    monkeypatch.setattr(ef, "EXPONENTS", {"p_2d": (2.0,), "p_3d": (1.0, 1.5, 3.0),
                                           "r": (1.0, 2.5, 4.0), "s": (1.0, 2.0),
                                           "u": (0.5, 1.0)})
-    coef, exponents, score = em._fit_exponents(synthetic_points(np.random.default_rng(2)))
+    coef, exponents, score = ef._fit_exponents(synthetic_points(np.random.default_rng(2)))
     assert exponents == EXPONENTS
     assert score == pytest.approx(0.0, abs=1e-9)
 
@@ -62,7 +65,7 @@ def test_cost_fit_recovers_power_law():
         d = em.Drivers("couette", 3, rng.uniform(1.5, 3.5), 5.0, 1e-3, 0.1, 3.0,
                        int(rng.integers(300, 20000)), int(rng.integers(300, 40000)))
         points.append((d, 2e-7 * d.work ** 0.95))
-    cost = em.fit_cost(points)
+    cost = ef.fit_cost(points)
     assert cost["alpha"] == pytest.approx(0.95, rel=1e-9)
     assert cost["k_3d"] == pytest.approx(2e-7, rel=1e-6)
 
@@ -96,10 +99,10 @@ def test_tighter_tolerance_is_never_cheaper(case):
     costs, errors = [], []
     for tol in (0.2, 0.1, 0.05, 0.03, 0.02):
         try:
-            choice = em.pick(get_case(case), tol)
+            choice = pk.pick(get_case(case), tol)
         except InputError:
             break
-        assert choice.expected_error <= em.SAFETY * tol
+        assert choice.expected_error <= pk.SAFETY * tol
         costs.append(choice.expected_cost)
         errors.append(choice.expected_error)
     assert len(costs) >= 2
@@ -108,17 +111,17 @@ def test_tighter_tolerance_is_never_cheaper(case):
 
 def test_pick_is_the_cheapest_feasible_candidate():
     case = get_case("couette_newtonian_3d")
-    choice = em.pick(case, 0.05)
-    rows = em.evaluate(case, em.load_model())
-    feasible = [cost for _, _, err, cost in rows if err <= em.SAFETY * 0.05]
+    choice = pk.pick(case, 0.05)
+    rows = pk.evaluate(case, em.load_model())
+    feasible = [cost for _, _, err, cost in rows if err <= pk.SAFETY * 0.05]
     assert choice.expected_cost == pytest.approx(min(feasible))
 
 
 def test_unreachable_tolerance_raises_with_smallest_error():
     with pytest.raises(InputError, match="not reachable.*smallest expected error"):
-        em.pick(get_case("couette_newtonian_3d"), 1e-4)
+        pk.pick(get_case("couette_newtonian_3d"), 1e-4)
     with pytest.raises(InputError, match="relative error in"):
-        em.pick(get_case("couette_newtonian_3d"), 0.0)
+        pk.pick(get_case("couette_newtonian_3d"), 0.0)
 
 
 def test_drivers_of_a_case_match_its_scene():
@@ -141,12 +144,12 @@ def test_plug_time_step_term_only_in_yield_stress_channels():
     xi = (12.0 - math.sqrt(44.0)) / 10.0
     assert d.plug == pytest.approx(xi, rel=1e-6)
     exponents = {"p_3d": 1.0, "r": 1.0, "s": 2.0, "t": 1.0, "u": 1.0}
-    plug_term = em._features(d, exponents)["courant_plug_3d"]
+    plug_term = em.features(d, exponents)["courant_plug_3d"]
     assert plug_term == pytest.approx(d.courant ** 2 * xi / (1.0 - xi), rel=1e-6)
     newtonian = get_case("poiseuille_newtonian_3d")
     d_newtonian = em.drivers(newtonian.build(newtonian.settings()), newtonian.settings())
     assert d_newtonian.plug == 0.0
-    assert "courant_plug_3d" not in em._features(d_newtonian, exponents)
+    assert "courant_plug_3d" not in em.features(d_newtonian, exponents)
 
 COUETTE = {"dimension": 3, "box": [10, 10, 10], "number_density": 4.096,
            "fluid": {"law": "papanastasiou", "params": {"mu_pl": 10.0, "mu_0": 990.0, "M": 100.0}},
@@ -190,8 +193,8 @@ def test_case_scene_gives_the_case_choice():
     """The adapter on a case's own scene chooses the same drivers as the case."""
     case = get_case("couette_newtonian_3d")
     scene = case.build(case.settings())
-    by_case = em.pick(case, 0.05)
-    by_scene = em.pick(scene_case(scene), 0.05)
+    by_case = pk.pick(case, 0.05)
+    by_scene = pk.pick(scene_case(scene), 0.05)
     for name in ("resolution", "length", "wi", "units", "n_particles", "n_steps"):
         assert getattr(by_scene.drivers, name) == pytest.approx(getattr(by_case.drivers, name))
 
@@ -211,7 +214,7 @@ def test_cli_tolerance_writes_choice_attributes(tmp_path, monkeypatch, capsys):
                  "--tolerance", "0.05"]) == 0
     attrs = read_run(out).attrs
     assert attrs["tolerance"] == 0.05
-    assert 0 < attrs["expected_error"] <= em.SAFETY * 0.05
+    assert 0 < attrs["expected_error"] <= pk.SAFETY * 0.05
     assert attrs["expected_cost_s"] > 0
     settings = json.loads(attrs["tolerance_settings"])
     assert {"resolution", "dt_coefficient", "wi_target", "side", "units"} <= set(settings)
@@ -251,7 +254,7 @@ def test_study_tolerance_key_adds_the_picked_configuration():
     from suspsim.convergence.study import configurations
 
     case = get_case("couette_newtonian_3d")
-    picked = em.pick(case, 0.05).settings
+    picked = pk.pick(case, 0.05).settings
     defaults = case.settings()
     out = configurations(case, {"tolerance": [0.05], "side": [10.0]})
     assert {k: v for k, v in picked.items() if v != defaults[k]} in out
@@ -289,11 +292,11 @@ def test_yield_term_is_a_power_of_the_bingham_number():
     base = dict(flow="poiseuille", dimension=3, resolution=1.6, length=4.0, wi=1e-3,
                 courant=0.1, units=0.0, n_particles=100, n_steps=100, rows=24)
     exponents = {"p_3d": 1.0, "r": 2.0, "s": 1.0, "t": 1.0, "u": 0.5}
-    features = em._features(em.Drivers(**base, bingham=9.0, plug=0.6), exponents)
+    features = em.features(em.Drivers(**base, bingham=9.0, plug=0.6), exponents)
     assert features["yield_poiseuille"] == pytest.approx(3.0)
-    assert em._features(em.Drivers(**base), exponents)["yield_poiseuille"] == 0.0
+    assert em.features(em.Drivers(**base), exponents)["yield_poiseuille"] == 0.0
     couette = em.Drivers(**{**base, "flow": "couette", "rows": 0, "units": 3.0})
-    assert "yield_poiseuille" not in em._features(couette, exponents)
+    assert "yield_poiseuille" not in em.features(couette, exponents)
 
 
 def test_bingham_number_bounded_by_the_trained_range():
@@ -353,11 +356,11 @@ def test_blow_up_caps_the_domain_even_where_the_finished_runs_fit_badly(monkeypa
     blown = em.Drivers(**{**d0.__dict__, "courant": 0.8})
     records = points + [(poor, 10 * sum(model.terms(poor).values())), (blown, math.nan)]
     fake_points = [(d, b, 1e-6 * d.work, "synthetic") for d, b in records]
-    monkeypatch.setattr(em, "training_points", lambda datasets: fake_points)
+    monkeypatch.setattr(ef, "training_points", lambda datasets: fake_points)
     # the exponents are known: the test is of the time-step cap, not of the exponent search
-    monkeypatch.setattr(em, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
+    monkeypatch.setattr(ef, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
                                           "t": (1.0,)})
-    fitted = em.fit([])
+    fitted = ef.fit([])
     assert fitted.provenance["unsafe_courant"] == {"couette_newtonian_3d": pytest.approx(0.8)}
 
 
@@ -373,11 +376,11 @@ def test_timestep_outlier_caps_the_domain(monkeypatch):
                         (wild, 20 * sum(model.terms(wild).values()))]
 
     fake_points = [(d, b, 1e-6 * d.work, "synthetic") for d, b in records]
-    monkeypatch.setattr(em, "training_points", lambda datasets: fake_points)
+    monkeypatch.setattr(ef, "training_points", lambda datasets: fake_points)
     # the exponents are known: the test is of the time-step cap, not of the exponent search
-    monkeypatch.setattr(em, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
+    monkeypatch.setattr(ef, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
                                           "t": (1.0,)})
-    fitted = em.fit([])
+    fitted = ef.fit([])
     assert fitted.provenance["unsafe_courant"] == {"couette_newtonian_3d": pytest.approx(0.9)}
     assert fitted.bounds["courant_couette_newtonian_3d"][1] < 0.9
     assert fitted.inflation < 1.5
@@ -396,10 +399,10 @@ def fit_known_exponents(monkeypatch, records):
     """fit() on (drivers, bound) ``records`` at the exponents of TRUE (the tests are of the
     inflation, not of the exponent search)."""
     fake_points = [(d, b, 1e-6 * d.work, "synthetic") for d, b in records]
-    monkeypatch.setattr(em, "training_points", lambda datasets: fake_points)
-    monkeypatch.setattr(em, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
+    monkeypatch.setattr(ef, "training_points", lambda datasets: fake_points)
+    monkeypatch.setattr(ef, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
                                           "t": (1.0,)})
-    return em.fit([])
+    return ef.fit([])
 
 
 def test_one_flow_with_large_ratios_does_not_inflate_the_other(monkeypatch):
@@ -449,7 +452,7 @@ def test_model_json_of_format_1_is_read_with_the_global_inflation(tmp_path):
 def known_grid(monkeypatch):
     """The exponent grid reduced to TRUE's exponents (the tests are of the inflation and the
     time-step margin, not of the exponent search)."""
-    monkeypatch.setattr(em, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
+    monkeypatch.setattr(ef, "EXPONENTS", {**{k: (v,) for k, v in EXPONENTS.items()},
                                           "t": (1.0,)})
 
 
@@ -467,12 +470,12 @@ def test_held_out_case_sets_its_class_inflation(monkeypatch):
         if d.flow == "poiseuille" and i % 5 == 0:
             case, bound = "doubled", 2.0 * bound
         records.append((d, bound, 1e-6 * d.work, case))
-    held = em.held_out_ratios(records)
+    held = ef.held_out_ratios(records)
     top, top_case = max(held["poiseuille_3d"])
     assert top == pytest.approx(2.0, rel=1e-6)
     assert top_case == "doubled"
     assert max(r for r, _ in held["couette_3d"]) == pytest.approx(1.0, abs=0.1)
-    fitted = em.fit_points(records)
+    fitted = ef.fit_points(records)
     in_sample = fitted.residuals["in_sample_class_inflation"]
     assert in_sample["poiseuille_3d"] < 2.0
     assert fitted.class_inflation["poiseuille_3d"] == pytest.approx(2.0, rel=1e-6)
@@ -485,13 +488,13 @@ def test_held_out_case_sets_its_class_inflation(monkeypatch):
 
 def test_cross_validated_inflation_is_floored_by_the_in_sample_one():
     held = {"couette_3d": [(1.3, "a"), (0.8, "b")], "poiseuille_3d": [(1.1, "c")]}
-    out = em.cross_validated_inflation({"couette_3d": 1.2, "poiseuille_3d": 1.5,
+    out = ef.cross_validated_inflation({"couette_3d": 1.2, "poiseuille_3d": 1.5,
                                         "poiseuille_2d": 1.1}, held)
     assert out == {"couette_3d": 1.3, "poiseuille_3d": 1.5, "poiseuille_2d": 1.1}
 
 
 def test_neighbouring_exponents_are_one_grid_step_each_side():
-    grid = em.neighbouring_exponents({"p_2d": 0.5, "p_3d": 2.0, "r": 4.0, "s": 4.0, "t": 2.0,
+    grid = ef.neighbouring_exponents({"p_2d": 0.5, "p_3d": 2.0, "r": 4.0, "s": 4.0, "t": 2.0,
                                       "u": 0.75})
     assert grid["p_2d"] == (0.5, 1.0)
     assert grid["p_3d"] == (1.5, 2.0, 3.0)
@@ -506,11 +509,11 @@ def test_stability_margin_from_a_blow_up_inside_the_calm_range():
     inliers = [em.Drivers("poiseuille", 2, 3.0, 5.0, 1e-3, c, 0.0, 100, 100, rows=30)
                for c in (0.3, 0.5, 0.7)]
     key = "poiseuille_newtonian_2d"
-    assert em.stability_margin(inliers, [(key, 0.8, True)]) == 1.0
-    assert em.stability_margin(inliers, [(key, 0.8, True), (key, 0.67, True)]) == \
+    assert ef.stability_margin(inliers, [(key, 0.8, True)]) == 1.0
+    assert ef.stability_margin(inliers, [(key, 0.8, True), (key, 0.67, True)]) == \
         pytest.approx(0.67 / 0.7)
-    assert em.stability_margin(inliers, [(key, 0.67, False)]) == 1.0
-    assert em.stability_margin(inliers, [("couette_newtonian_2d", 0.2, True)]) == 1.0
+    assert ef.stability_margin(inliers, [(key, 0.67, False)]) == 1.0
+    assert ef.stability_margin(inliers, [("couette_newtonian_2d", 0.2, True)]) == 1.0
 
 
 def test_blow_up_inside_the_calm_range_shortens_every_time_step_range(monkeypatch):
@@ -527,7 +530,7 @@ def test_blow_up_inside_the_calm_range_shortens_every_time_step_range(monkeypatc
     records = [(d, b, 1e-6 * d.work, "a") for d, b in points] + [
         (small, sum(model.terms(small).values()), 1e-6 * small.work, "b"),
         (blown, math.nan, math.nan, "b")]
-    fitted = em.fit_points(records, cross_validate=False)
+    fitted = ef.fit_points(records, cross_validate=False)
     margin = fitted.provenance["courant_margin"]
     assert fitted.provenance["unsafe_courant"] == {"couette_newtonian_3d": 0.9 * calm_edge}
     calm_below = max(d.courant for d, _ in points

@@ -38,7 +38,7 @@ import os
 import pytest
 
 from suspsim.convergence.cases import get_case
-from suspsim.convergence.error_model import pick
+from suspsim.convergence.picker import pick
 from suspsim.convergence.holdout import COST_RATIO, check
 from suspsim.errors import InputError
 

@@ -69,8 +69,6 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from suspsim.sph import JIT_OPTIONS
-
 from . import harmonics as sh
 from .overlap import fibonacci_directions
 from .packing import Packing

@@ -24,7 +24,8 @@ import numpy as np
 import xarray as xr
 
 from suspsim.convergence.cases import Case, get_case
-from suspsim.convergence.error_model import ErrorModel, evaluate, load_model, pick
+from suspsim.convergence.error_model import ErrorModel, load_model
+from suspsim.convergence.picker import evaluate, pick
 from suspsim.convergence.measure import run_or_failure
 from suspsim.convergence.study import case_dataset
 from suspsim.errors import InputError

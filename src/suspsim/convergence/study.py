@@ -54,7 +54,7 @@ def configurations(case: AnyCase, values: Mapping[str, Sequence[Any]],
     """The overrides of each configuration (``{}`` is the case's defaults), without repeats.
 
     ``tolerance: [ε, ...]`` among the values adds, for each ε, the configuration the error
-    model's picker chooses for that relative error (:func:`.error_model.pick`; an unreachable
+    model's picker chooses for that relative error (:func:`.picker.pick`; an unreachable
     ε is an InputError), so a study measures what ``suspsim run --tolerance`` would run."""
     if sweep not in SWEEPS:
         raise InputError("speed_error", f"sweep must be one of {', '.join(SWEEPS)}, not '{sweep}'",
@@ -70,7 +70,7 @@ def configurations(case: AnyCase, values: Mapping[str, Sequence[Any]],
     else:
         combos = [{}] + [{axis: value} for axis, listed in values.items() for value in listed]
     if tolerances:
-        from suspsim.convergence.error_model import pick
+        from suspsim.convergence.picker import pick
 
         combos += [pick(case, float(tol)).settings for tol in tolerances]
     out, seen = [], set()

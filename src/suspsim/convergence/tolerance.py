@@ -1,5 +1,5 @@
 """Tolerance-driven set-up of a scene (``suspsim run SCENE --tolerance ε``): the scene gives the
-physics, the error model's picker (:func:`~.error_model.pick`) the numerics.
+physics, the error model's picker (:func:`~.picker.pick`) the numerics.
 
 Supported scenes: SPH fluid scenes (no inclusions) of periodic Couette or split-force
 Poiseuille flow, 2D or 3D, any generalized-Newtonian law. A scene is turned into a case-like
@@ -29,7 +29,8 @@ import math
 from typing import Any, Mapping
 
 from suspsim.convergence.cases import Axis, Case, _channel_box, snapped_resolution
-from suspsim.convergence.error_model import FIXED, Choice, ErrorModel, load_model, pick
+from suspsim.convergence.error_model import FIXED, ErrorModel, load_model
+from suspsim.convergence.picker import Choice, pick
 from suspsim.errors import InputError
 from suspsim.rheology.laws import LAW_SPECS
 from suspsim.scene import Scene, scene_from_dict

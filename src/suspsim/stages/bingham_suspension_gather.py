@@ -135,7 +135,7 @@ def gather_suspension(block: Mapping[str, Any], newtonian: Sequence[xr.Dataset],
     def table(name: str) -> np.ndarray:
         return np.array([float(run[name]) for run in runs]).reshape(len(rates), len(seeds))
 
-    ratio, phi = settings["viscosity_ratio"], settings["volume_fraction"]
+    ratio = settings["viscosity_ratio"]
     x = np.array(rates)
     plastic = matrix_plastic_ratio(x, ratio)
     eta, eta_err = table("relative_viscosity"), table("relative_viscosity_stderr")

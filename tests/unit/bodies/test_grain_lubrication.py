@@ -5,7 +5,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.spatial import cKDTree
 
 from suspsim.bodies import harmonics as sh
 from suspsim.bodies.grain_contacts import (CONTACT_WIDTH, C_A, C_B, GAP, grain_pair_contact,

@@ -10,7 +10,7 @@ from suspsim.sph.terms.gradient import corrected_gradient, invert_symmetric, she
 from suspsim.sph.terms.normalisation import (continuum_dissipation, moment_dissipation,
                                              normalisation_factor, pair_dissipation,
                                              quadratic_form, strain_form)
-from suspsim.sph.terms.pressure import equation_of_state, pressure_pair, pressure_term
+from suspsim.sph.terms.pressure import pressure_pair, pressure_term
 from suspsim.sph.terms.viscous import (bulk_factor, explicit_bulk_term, pair_viscosity,
                                        viscous_pair, viscous_weights)
 
