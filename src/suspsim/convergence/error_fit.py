@@ -16,8 +16,8 @@ each of its runs that the fold's model would let the picker use (inside the fold
 class still trained), and inflate each class by the largest such held-out ratio, floored by
 the largest in-sample ratio so the inflated model still bounds every training point; a class
 without training points takes the largest inflation (``inflation``). The picker asks inflated
-E ≤ tolerance (:data:`.picker.SAFETY` = 1): the held-out ratio is already the margin for a case the
-model has not seen, and the earlier in-sample maximum with a 0.8 safety factor counted that
+E ≤ tolerance (:data:`.picker.SAFETY` = 1): the held-out ratio is already the margin for a case
+the model has not seen, and the earlier in-sample maximum with a 0.8 safety factor counted that
 margin twice (the second blind set's 2D channel and Bingham channel picks met 5 % at 2.8-3×
 the cheapest cost). Measured in the packaged fit (class: inflation; largest held-out ratio,
 its case, held-out points/cases; largest in-sample ratio): Couette 2D 1.62; 1.33, Newtonian 2D,

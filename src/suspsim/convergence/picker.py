@@ -1,10 +1,9 @@
-"""The tolerance-driven picker (issue 7: ``suspsim run --tolerance``): the cheapest
-configuration of a case whose expected error, by the measured :mod:`.error_model`, meets a
-tolerance.
+"""The tolerance-driven picker (issue 7: ``suspsim run --tolerance``).
 
-The picker (:func:`pick`) searches the grid of a case-like description (:class:`~.cases.Case`:
-the physics fixed in dimensionless form, the numerics as settings) for the cheapest
-configuration whose expected error meets the tolerance.
+:func:`pick` searches the grid (:data:`~.error_model.GRID`) of a case-like description
+(:class:`~.cases.Case`: the physics fixed in dimensionless form, the numerics as settings) for
+the cheapest configuration whose expected error, by the measured :mod:`.error_model`, meets the
+tolerance.
 """
 from __future__ import annotations
 

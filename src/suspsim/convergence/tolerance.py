@@ -12,11 +12,11 @@ the scene's in dimensionless form, as :mod:`.cases` keeps it:
   the Bingham number stay (stresses in the output are in the new density's units: multiply by
   ``tolerance_stress_scale``⁻¹ for the scene's). The run becomes 1 strain unit of transient plus
   the chosen averaged units;
-- Poiseuille: the channel is kept and its width W = L_y/2 in units of h is chosen. With s = W_scene/W
-  (old h per new h) and the time unit kept, kinematic quantities scale as lengths: g → g/s, and
-  stress-like parameters → (n/n_scene) × parameter/s², so Re, Bn and every time scale (τ) stay;
-  the run time, transient and output interval [τ] are unchanged; the lateral sides follow the
-  cases (3.75 h in 3D, 8 h in 2D, whole rows).
+- Poiseuille: the channel is kept and its width W = L_y/2 in units of h is chosen. With
+  s = W_scene/W (old h per new h) and the time unit kept, kinematic quantities scale as lengths:
+  g → g/s, and stress-like parameters → (n/n_scene) × parameter/s², so Re, Bn and every time
+  scale (τ) stay; the run time, transient and output interval [τ] are unchanged; the lateral
+  sides follow the cases (3.75 h in 3D, 8 h in 2D, whole rows).
 
 In both the time step and sound speed are automatic from the chosen ``dt_viscous_coefficient``
 and ``wi_target`` (the scene's ``run.dt``/``run.sound_speed`` are dropped), the kernel is lucy
