@@ -9,11 +9,13 @@ This measures how η_r converges with a/h at fixed φ and fixed box/a = 6 (the s
 spheres, about 21 at φ = 0.4, so only the resolution changes; the side rounded to whole
 lattice spacings), in the Newtonian matrix of
 :mod:`suspsim.validation.suspension`, one thread per run. Prints a Markdown table (η_r ± the
-strain-unit standard error, CPU time, particles) and writes nothing else. ``--set`` takes a
+strain-unit standard error, CPU time, particles) and writes nothing else; a run that stops on
+its health limits is reported with the reason and the next one starts. ``--set`` takes a
 scene key for every run (e.g. ``inclusions.lubrication.friction=0.5``).
 """
 import argparse
 
+from suspsim.errors import NumericalError
 from suspsim.rheology.suspension import published_envelope
 from suspsim.validation.suspension import NUMBER_DENSITY, parse_overrides, relative_viscosity
 
@@ -42,8 +44,12 @@ def main() -> None:
     for radius in args.radii:
         for seed in args.seeds:
             box = SPACING * round(BOX_PER_RADIUS * radius / SPACING)
-            r = relative_viscosity(phi=args.phi, radius=radius, box=box, seed=seed,
-                                   transient=transient, units=units, overrides=overrides)
+            try:
+                r = relative_viscosity(phi=args.phi, radius=radius, box=box, seed=seed,
+                                       transient=transient, units=units, overrides=overrides)
+            except NumericalError as err:
+                print(f"| {radius:g} | {box:g} | {seed} | | stopped: {err} | | |", flush=True)
+                continue
             print(f"| {radius:g} | {box:g} | {seed} | {r.phi:.3f} | {r.relative_viscosity:.3f} "
                   f"± {r.stderr:.3f} | {r.cpu_time:.0f} | {r.n_particles} |", flush=True)
 
