@@ -118,10 +118,9 @@ def step_zero(sphere_sim: Simulation, grain_sim: Simulation) -> str:
             grain_lubrication_pass(b.centres, b.rotations(), velocities, omegas, b.mass,
                                    b.moments, box, 0.0, sim._rate, sim.dt, law.code, law.packed,
                                    cutoff, min_gap, strength, friction, rolling, sf.points,
-                                   sf.normals,
-                                   sf.first_directions, sf.osculating, sf.principal_curvatures,
-                                   sf.tables, sf.to_packing, sf.centroids, sf.reach, virial,
-                                   stats)
+                                   sf.normals, sf.first_directions, sf.osculating,
+                                   sf.principal_curvatures, sf.tables, sf.to_packing,
+                                   sf.centroids, sf.reach, virial, stats)
         else:
             lubrication_pass(b.centres, sim._body_radii, velocities, omegas, b.mass,
                              b.moments.mean(axis=1), box, 0.0, sim._rate, sim.dt, law.code,
@@ -140,7 +139,7 @@ def contact_law(grain_sim: Simulation) -> str:
     """At step 0, over the grain pairs within the cutoff gap: the osculating radii R/a and the
     squeeze coefficient c1 (SPEC §3.4) over that of two spheres of the grains' equivalent
     radii, c1 = 6π (a1 a2/(a1 + a2))²: what the grain pathway makes of the shape."""
-    cutoff, _, _, _, _, _, sf = grain_sim._lubrication
+    cutoff, sf = grain_sim._lubrication.cutoff_gap, grain_sim._lubrication.surfaces
     b, box, radii = grain_sim.bodies, grain_sim._box, grain_sim._body_radii
     rotations = b.rotations()
     contact = np.zeros(CONTACT_WIDTH)

@@ -27,6 +27,7 @@ import contextlib
 import dataclasses
 import logging
 import time as time_module
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
@@ -56,6 +57,22 @@ from suspsim.sph.timestep import auto_sound_speed, max_viscosity, stable_time_st
 from suspsim.threads import use_threads
 
 log = logging.getLogger(__name__)
+
+
+class LubricationSetup(NamedTuple):
+    """What the lubrication pass of a run takes from its scene (``inclusions.lubrication``):
+    cutoff gap s_c and inner cap s_min [h], repulsion strength C = k μ(γ̇) γ̇ ā² s_min⁸ (ā the
+    bodies' mean radius), sliding and rolling friction μ_c, μ_r [1], the bodies' scalar moments
+    of inertia [m h²] and, for grains, their surface samples (``bodies.grain_contacts``)."""
+
+    cutoff_gap: float
+    min_gap: float
+    strength: float
+    friction: float
+    rolling_friction: float
+    inertia: np.ndarray
+    surfaces: Any
+
 
 #: Verlet skin [h] (list cutoff h + skin) [choice; the foundation's benchmark value].
 SKIN = 0.2
@@ -392,10 +409,8 @@ class Simulation:
                           self._body_virial)
         return forces, torques
 
-    def _lubrication_setup(self):
-        """(s_c, s_min, repulsion C, friction μ_c, rolling friction μ_r, scalar inertia, grain
-        surfaces or None) or None (``inclusions.lubrication``): C = k μ(γ̇) γ̇ ā² s_min⁸ with ā
-        the bodies' mean radius; grains get their surface samples (``bodies.grain_contacts``)."""
+    def _lubrication_setup(self) -> LubricationSetup | None:
+        """The :class:`LubricationSetup` of the scene, None without bodies or lubrication."""
         spec = self.scene.inclusions.lubrication
         if self.bodies is None or not spec.enabled:
             return None
@@ -407,8 +422,9 @@ class Simulation:
             g = self._grains
             surfaces = grain_surfaces(g["coefficients"], self._body_radii, g["support_radii"],
                                       g["centre_shift"], g["body_to_principal"])
-        return (spec.cutoff_gap, spec.min_gap, strength, spec.friction, spec.rolling_friction,
-                self.bodies.moments.mean(axis=1), surfaces)
+        return LubricationSetup(spec.cutoff_gap, spec.min_gap, strength, spec.friction,
+                                spec.rolling_friction, self.bodies.moments.mean(axis=1),
+                                surfaces)
 
     def _lubricate(self, time: float, rotations) -> None:
         """Implicit lubrication impulses on the kicked bodies (``bodies.lubrication_pass``;
