@@ -1,8 +1,9 @@
 """The ``suspsim`` command line: ``suspsim fit FILE [--law NAME|auto] [--sample ID] [--out F] [--plot F]``.
 
-Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N] [--tolerance EPS]`` (an SPH
-run, see :mod:`suspsim.run`, or a DST run of a wyart_cates scene, see :mod:`suspsim.dst.run`;
-``--tolerance`` chooses the numerics from the error model, :mod:`suspsim.convergence.tolerance`),
+Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N] [--tolerance EPS
+[--no-verify]]`` (an SPH run, see :mod:`suspsim.run`, or a DST run of a wyart_cates scene, see
+:mod:`suspsim.dst.run`; ``--tolerance`` chooses the numerics from the error model and checks
+the runs against the exact solution, :mod:`suspsim.convergence.tolerance`),
 ``suspsim bench [--scene NAME] [--threads N] [--steps K] [--particles N] [--json]`` and
 ``suspsim pack --shape sphere|sand --phi PHI --radius A --box LX LY LZ --out PACK.nc
 [--polydispersity S] [--seed N] ...`` (a random packing, see :mod:`suspsim.bodies.packing`).
@@ -16,6 +17,7 @@ failure (the last good checkpoint is kept; a packing that cannot be reached writ
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import platform
 import sys
@@ -62,9 +64,13 @@ def _build_parser() -> argparse.ArgumentParser:
                      "scene's run.threads)")
     run.add_argument("--tolerance", type=float, help="relative error to meet: the scene gives "
                      "the physics, the measured error model chooses resolution, time step, "
-                     "sound speed, box side or channel width and averaging at least expected "
-                     "cost (SPH fluid couette/poiseuille scenes; see "
-                     "suspsim.convergence.tolerance)")
+                     "sound speed, box side or channel width and averaging; the runs are "
+                     "measured against the flow's exact solution until one meets it, each "
+                     "missed one recalibrating the model (SPH fluid couette/poiseuille scenes; "
+                     "see suspsim.convergence.tolerance)")
+    run.add_argument("--no-verify", action="store_true", help="with --tolerance: one run of "
+                     "the cheapest set-up whose inflated model bound meets the tolerance, not "
+                     "measured")
 
     bench = sub.add_parser("bench", help="measure the solver's speed on standard scenes")
     bench.add_argument("--scene", choices=BENCH_SCENES, help="one scene (default: all)")
@@ -152,17 +158,28 @@ def _cmd_run(args) -> int:
 
     scene = load_any_scene(args.scene)
     if args.tolerance is not None:
-        from .convergence.tolerance import SUPPORTED, choose
-        from .run import run_scene
+        from .convergence import tolerance
 
         if not isinstance(scene, Scene):
-            raise InputError(args.scene, SUPPORTED)
-        scene, choice, attrs = choose(scene, args.tolerance)
-        print(f"tolerance {args.tolerance:g}: {attrs['tolerance_settings']}; expected error "
-              f"{choice.expected_error:.3g}, expected cost {choice.expected_cost:.3g} s CPU "
-              f"({choice.drivers.n_particles} particles, {choice.drivers.n_steps} steps)")
-        out = run_scene(scene, args.out, resume=args.resume, threads=args.threads,
-                        extra_attrs=attrs)
+            raise InputError(args.scene, tolerance.SUPPORTED)
+        if args.no_verify:
+            from .run import run_scene
+
+            scene, choice, attrs = tolerance.choose(scene, args.tolerance)
+            print(f"tolerance {args.tolerance:g}: {attrs['tolerance_settings']}; expected error "
+                  f"{choice.expected_error:.3g}, expected cost {choice.expected_cost:.3g} s CPU "
+                  f"({choice.drivers.n_particles} particles, {choice.drivers.n_steps} steps)")
+            out = run_scene(scene, args.out, resume=args.resume, threads=args.threads,
+                            extra_attrs=attrs)
+        else:
+            attempts = tolerance.run_verified(scene, args.tolerance, args.out,
+                                              resume=args.resume, threads=args.threads)
+            for k, a in enumerate(attempts, 1):
+                print(f"tolerance {args.tolerance:g}, attempt {k}: {json.dumps(a.settings)}; "
+                      f"expected error {a.calibration * a.model_error:.3g}, measured "
+                      + ("blew up" if a.blew_up else f"{a.measured:.3g}")
+                      + f", {a.cpu_time:.3g} s CPU")
+            out = args.out
     elif isinstance(scene, Scene):
         from .run import run_scene
 

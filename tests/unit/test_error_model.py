@@ -160,9 +160,10 @@ def test_cli_tolerance_writes_choice_attributes(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(run_module, "_solver", lambda: FakeSimulation)
     out = tmp_path / "run.nc"
     assert main(["-q", "run", str(write(tmp_path, COUETTE)), "--out", str(out),
-                 "--tolerance", "0.05"]) == 0
+                 "--tolerance", "0.05", "--no-verify"]) == 0
     attrs = read_run(out).attrs
     assert attrs["tolerance"] == 0.05
+    assert attrs["tolerance_mode"] == "bound"
     assert 0 < attrs["expected_error"] <= pk.SAFETY * 0.05
     assert attrs["expected_cost_s"] > 0
     settings = json.loads(attrs["tolerance_settings"])

@@ -9,14 +9,16 @@ of :func:`~.picker.pick` by the inflated bound; the cost paid is its CPU time.
 
 For tolerance ε the check passes when the answer's measured error bound (error + 2 standard
 errors, :mod:`.study`) is ≤ ε and the cost paid is ≤ 2 × the CPU time of the cheapest measured
-configuration whose bound is ≤ ε. The comparison runs are, per geometry (every setting but the
-time step and sound speed), the cheapest expected variant among the candidates expected to cost
-less than the answer and not run yet, cheapest first, at most ``max_runs`` − 1 of them.
+configuration whose bound is ≤ ε. The check can only fail on a configuration that meets ε at
+less than half the cost paid, so the comparison runs every distinct run the picker could have
+chosen (geometry and step count; of the variants with the same cost, the one the model expects
+most accurate) expected to cost less than :data:`COST_SLACK` × paid/2, unless it ran already,
+cheapest first, at most ``max_runs`` of them.
 
 Command (writes every run as a case Dataset, the attempts first, with the check in its
 attributes)::
 
-    python -m suspsim.convergence.holdout CASE TOLERANCE OUT.nc [MAX_RUNS] [--bound]
+    python -m suspsim.convergence.holdout CASE TOLERANCE OUT.nc [MAX_COMPARISONS] [--bound]
 """
 from __future__ import annotations
 
@@ -40,6 +42,12 @@ from suspsim.errors import InputError
 log = logging.getLogger(__name__)
 #: Largest allowed ratio of the cost paid to the cheapest configuration meeting the tolerance.
 COST_RATIO = 2.0
+#: The comparison runs every configuration expected to cost less than COST_SLACK × paid /
+#: COST_RATIO [1] [choice]: 1.5, about twice the cost model's rms log error (0.23) above the
+#: cost at which a configuration meeting the tolerance would fail the check.
+COST_SLACK = 1.5
+#: Default cap on the comparison runs.
+MAX_COMPARISONS = 12
 _NUMERICS = ("dt_coefficient", "wi_target")
 
 
@@ -49,19 +57,20 @@ def _key(settings: dict[str, Any], drop: Iterable[str] = ()) -> str:
 
 def comparison_settings(case: Case, model: ErrorModel, below_cost: float,
                         done: Sequence[dict[str, Any]], n: int) -> list[dict[str, Any]]:
-    """Up to ``n`` settings, one per geometry not in ``done``, each its geometry's cheapest
-    expected variant, among the candidates expected to cost less than ``below_cost`` [s]."""
+    """Up to ``n`` settings, cheapest first: one per distinct run (geometry and step count)
+    expected to cost less than ``below_cost`` [s], the variant the model expects most
+    accurate, unless some variant of that run is in ``done``."""
     ran = {_key(s) for s in done}
-    seen = {_key(s, _NUMERICS) for s in done}
+    groups: dict[tuple[str, int], list] = {}
+    for settings, d, error, cost in evaluate(case, model):
+        if cost < below_cost:
+            groups.setdefault((_key(settings, _NUMERICS), d.n_steps), []).append(
+                (error, cost, settings))
     out = []
-    for settings, _, _, cost in sorted(evaluate(case, model), key=lambda r: r[3]):
-        if cost >= below_cost or len(out) >= n:
-            break
-        geometry = _key(settings, _NUMERICS)
-        if geometry not in seen and _key(settings) not in ran:
-            seen.add(geometry)
-            out.append(settings)
-    return out
+    for rows in sorted(groups.values(), key=lambda g: min(r[1] for r in g)):
+        if not any(_key(settings) in ran for *_, settings in rows):
+            out.append(min(rows, key=lambda r: r[0])[2])
+    return out[:n]
 
 
 def _measure(case: Case, settings: dict[str, Any]) -> dict[str, Any]:
@@ -81,7 +90,7 @@ def _bound(record: dict[str, Any]) -> float:
     return record["error"] + STDERR_FACTOR * (stderr if math.isfinite(stderr) else 0.0)
 
 
-def check(case_name: str, tolerance: float, *, max_runs: int = 6,
+def check(case_name: str, tolerance: float, *, max_runs: int = MAX_COMPARISONS,
           model: ErrorModel | None = None, verified: bool = True) -> xr.Dataset:
     """Run the check of ``case_name`` at ``tolerance`` [1] (module docstring); the Dataset's
     first ``attempts`` configurations are what ``--tolerance`` ran (the last one its answer),
@@ -91,6 +100,7 @@ def check(case_name: str, tolerance: float, *, max_runs: int = 6,
     ``passed`` (1/0) and ``calibration`` or ``inflation`` [1] as attributes."""
     model = model or load_model()
     case = get_case(case_name)
+
     def run(settings):
         record = _measure(case, settings)
         return _bound(record), record["cpu_time"], record
@@ -100,20 +110,19 @@ def check(case_name: str, tolerance: float, *, max_runs: int = 6,
         records = [a.result for a in attempts]
         answer = attempts[-1]
         expected = answer.calibration * answer.model_error
-        below = model.expected_cost(answer.drivers)
         scale = {"calibration": answer.calibration}
     else:
         choice = pick(case, tolerance, model)
         records = [_measure(case, choice.settings)]
-        expected, below = choice.expected_error, choice.expected_cost
+        expected = choice.expected_error
         scale = {"inflation": model.inflation_of(choice.drivers)}
     done = [{k: r[k] for k in case.settings()} for r in records]
-    records += [_measure(case, s) for s in
-                comparison_settings(case, model, below, done, max_runs - 1)]
-    ds = case_dataset(case, records)
     n = len(done)
+    paid = float(sum(r["cpu_time"] for r in records))
+    records += [_measure(case, s) for s in comparison_settings(
+        case, model, COST_SLACK * paid / COST_RATIO, done, max_runs)]
+    ds = case_dataset(case, records)
     bound, cpu = ds["error_bound"].values, ds["cpu_time"].values
-    paid = float(cpu[:n].sum())
     meets = np.flatnonzero(bound <= tolerance)
     cheapest = float(cpu[meets].min()) if meets.size else float("nan")
     ratio = paid / cheapest if meets.size else float("nan")
@@ -138,7 +147,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s")
     try:
-        ds = check(args[0], float(args[1]), max_runs=int(args[3]) if len(args) == 4 else 6,
+        ds = check(args[0], float(args[1]), max_runs=int(args[3]) if len(args) == 4 else MAX_COMPARISONS,
                    verified=verified)
     except InputError as err:
         # the picker refuses, or no attempt met the tolerance: nothing to compare

@@ -196,10 +196,13 @@ def verified_pick(case: Case, tolerance: float, run: Runner, model: ErrorModel |
             calibration = measured / error
         else:
             courant_cap = min(courant_cap, d.courant)
+    best = min((r[2] for r in rows), default=math.inf)
+    if not attempts:
+        raise InputError("--tolerance", f"{case.name}: tolerance {tolerance:g} is not reachable "
+                         f"within the modelled grid; the smallest expected error is {best:.3g}")
     done = "; ".join(f"{a.model_error * a.calibration:.3g} expected, "
                      + ("blew up" if a.blew_up else f"{a.measured:.3g} measured")
-                     for a in attempts) or "no run"
-    best = min((r[2] for r in rows), default=math.inf)
+                     for a in attempts)
     raise InputError("--tolerance", f"{case.name}: tolerance {tolerance:g} not met ({done}); "
                      f"the smallest model error on the grid is {best:.3g}, times the "
                      f"calibration {calibration:.3g}")

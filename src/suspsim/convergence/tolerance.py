@@ -1,5 +1,11 @@
 """Tolerance-driven set-up of a scene (``suspsim run SCENE --tolerance ε``): the scene gives the
-physics, the error model's picker (:func:`~.picker.pick`) the numerics.
+physics, the error model's picker the numerics.
+
+Two modes. Verified (the default, :func:`run_verified`): the picker's attempts
+(:func:`~.picker.verified_pick`) are run and each measured against the flow's exact solution
+(:func:`measured_error`) until one meets ε; the output is that run and records every attempt.
+Bound (``--no-verify``, :func:`choose`): one run of the cheapest configuration whose inflated
+model bound (:func:`~.picker.pick`) meets ε, not checked.
 
 Supported scenes: SPH fluid scenes (no inclusions) of periodic Couette or split-force
 Poiseuille flow, 2D or 3D, any generalized-Newtonian law. A scene is turned into a case-like
@@ -25,18 +31,31 @@ and the start jitter 0.1 (the model's training settings).
 from __future__ import annotations
 
 import json
+import logging
 import math
-from typing import Any, Mapping
+import time
+from os import PathLike
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import xarray as xr
 
 from suspsim.convergence.cases import Axis, Case, _channel_box, snapped_resolution
 from suspsim.convergence.error_model import FIXED, ErrorModel, load_model
-from suspsim.convergence.picker import Choice, pick
-from suspsim.errors import InputError
+from suspsim.convergence.picker import Attempt, Choice, pick, verified_pick
+from suspsim.convergence.study import STDERR_FACTOR
+from suspsim.errors import InputError, NumericalError
+from suspsim.io.atomic import atomic_path
+from suspsim.io.netcdf import read_run
+from suspsim.reference.poiseuille import split_force_poiseuille_profile
 from suspsim.rheology.laws import LAW_SPECS
+from suspsim.run import checkpoint_path, run_scene
 from suspsim.scene import Scene, scene_from_dict
+from suspsim.validation.flows import l2_peak_error
 
 SUPPORTED = ("--tolerance supports SPH fluid scenes without inclusions of couette or poiseuille "
              "flow (2D or 3D); DST scenes, suspensions and other flows have no error model")
+log = logging.getLogger(__name__)
 #: Strain units of transient discarded before averaging in a Couette run [1] (as the cases).
 TRANSIENT_STRAIN = 1.0
 
@@ -114,26 +133,111 @@ def scene_case(scene: Scene) -> Case:
     return Case(name, f"{scene.flow.type} scene {scene.source}", "none", axes, build, unused)
 
 
-def choose(scene: Scene, tolerance: float, model: ErrorModel | None = None
-           ) -> tuple[Scene, Choice, dict[str, Any]]:
-    """The scene set up for ``tolerance`` [1], the picker's choice, and the run attributes that
-    record it (:data:`suspsim.io.variables.RUN_ATTRIBUTES`)."""
-    model = model or load_model()
-    case = scene_case(scene)
-    choice = pick(case, tolerance, model)
-    chosen = scene_from_dict(case.scene(choice.settings), source=f"{scene.source} (tolerance)")
+def _set_up(scene: Scene, case: Case, settings: Mapping[str, Any]) -> tuple[Scene, dict]:
+    """The scene rescaled to ``settings`` and the run attributes of the set-up."""
+    chosen = scene_from_dict(case.scene(settings), source=f"{scene.source} (tolerance)")
     if scene.flow.type == "couette":
         scale = chosen.number_density / scene.number_density
     else:
         s = 0.5 * scene.box[1] / (0.5 * chosen.box[1])
         scale = chosen.number_density / scene.number_density / s ** 2
-    keys = [a.name for a in case.axes]
-    attrs = {"tolerance": float(tolerance), "expected_error": choice.expected_error,
-             "expected_cost_s": choice.expected_cost, "tolerance_stress_scale": scale,
-             "tolerance_settings": json.dumps({k: choice.settings[k] for k in keys}),
-             "tolerance_error_terms": json.dumps(choice.terms),
-             "error_model": json.dumps({**model.provenance,
-                                       "inflation": model.inflation_of(choice.drivers)})}
     if not math.isfinite(scale):
         raise InputError(scene.source, "cannot rescale the scene")
+    keys = [a.name for a in case.axes]
+    return chosen, {"tolerance_stress_scale": scale,
+                    "tolerance_settings": json.dumps({k: settings[k] for k in keys})}
+
+
+def choose(scene: Scene, tolerance: float, model: ErrorModel | None = None
+           ) -> tuple[Scene, Choice, dict[str, Any]]:
+    """The scene set up for ``tolerance`` [1] by the inflated bound (:func:`~.picker.pick`,
+    no run), the picker's choice, and the run attributes that record it
+    (:data:`suspsim.io.variables.RUN_ATTRIBUTES`)."""
+    model = model or load_model()
+    case = scene_case(scene)
+    choice = pick(case, tolerance, model)
+    chosen, attrs = _set_up(scene, case, choice.settings)
+    attrs.update(tolerance=float(tolerance), tolerance_mode="bound",
+                 expected_error=choice.expected_error, expected_cost_s=choice.expected_cost,
+                 tolerance_error_terms=json.dumps(choice.terms),
+                 error_model=json.dumps({**model.provenance,
+                                         "inflation": model.inflation_of(choice.drivers)}))
     return chosen, choice, attrs
+
+
+def measured_error(scene: Scene, result: xr.Dataset) -> float:
+    """Error bound [1] of a finished run ``result`` of ``scene`` against the flow's exact
+    solution, as the cases measure it (:mod:`.cases`): Couette |η/μ(γ̇) − 1| + 2 standard
+    errors (the run's block-average ``viscosity_stderr``); Poiseuille the L2/peak error of the
+    steady-window ``velocity_profile`` against the split-force profile of the law (SPEC §6.2)."""
+    if scene.flow.type == "couette":
+        mu = float(scene.fluid.law.viscosity(scene.flow.shear_rate))
+        stderr = float(result["viscosity_stderr"]) / mu
+        return (abs(float(result["viscosity"]) / mu - 1.0)
+                + STDERR_FACTOR * (stderr if math.isfinite(stderr) else 0.0))
+    y = result["y"].values
+    reference = split_force_poiseuille_profile(
+        scene.fluid.law, scene.density * scene.flow.body_force, scene.box[1], y)
+    return l2_peak_error(result["velocity_profile"].values, reference)
+
+
+def attempt_path(out: Path, index: int) -> Path:
+    """Where attempt ``index`` (from 1) of a verified run writes: beside ``out``."""
+    return out.with_name(f"{out.stem}.attempt{index}{out.suffix}")
+
+
+def run_verified(scene: Scene, tolerance: float, out: str | PathLike, *, resume: bool = False,
+                 threads: int | None = None, model: ErrorModel | None = None,
+                 run: Callable[..., Path] | None = None) -> list[Attempt]:
+    """``suspsim run SCENE --tolerance ε``: the attempts of :func:`~.picker.verified_pick`, each
+    a run of the rescaled scene (``run``, :func:`suspsim.run.run_scene`) to ``OUT.attemptK.nc``
+    measured by :func:`measured_error`. The one that meets the tolerance becomes ``out`` with
+    the run attributes ``tolerance``, ``tolerance_mode`` (verified), ``expected_error`` (the
+    calibrated model's), ``measured_error``, ``expected_cost_s``, ``tolerance_settings``,
+    ``tolerance_stress_scale``, ``tolerance_error_terms``, ``tolerance_attempts`` (every
+    attempt's settings, model error, calibration, measured error and CPU time) and
+    ``error_model``; the missed attempts' files are removed. With ``resume`` a finished attempt
+    file of the same settings is measured again rather than re-run and an interrupted one
+    resumes from its checkpoint (the attempts are deterministic). An InputError when no
+    attempt meets the tolerance (the files of the attempts stay)."""
+    run = run or run_scene
+    model = model or load_model()
+    case = scene_case(scene)
+    out = Path(out)
+    runs: list[Path] = []
+
+    def attempt(settings):
+        chosen, attrs = _set_up(scene, case, settings)
+        path = attempt_path(out, len(runs) + 1)
+        runs.append(path)
+        c0 = time.process_time()
+        if not (resume and path.exists()
+                and read_run(path).attrs.get("tolerance_settings") == attrs["tolerance_settings"]):
+            log.info("tolerance %g: attempt %d, %s", tolerance, len(runs),
+                     attrs["tolerance_settings"])
+            try:
+                run(chosen, path, resume=resume and checkpoint_path(path).exists(),
+                    threads=threads, extra_attrs={"tolerance": float(tolerance), **attrs})
+            except NumericalError as err:
+                log.warning("tolerance %g: attempt %d blew up: %s", tolerance, len(runs), err)
+                return math.inf, time.process_time() - c0, None
+        measured = measured_error(chosen, read_run(path))
+        log.info("tolerance %g: attempt %d measured %.3g", tolerance, len(runs), measured)
+        return measured, time.process_time() - c0, (chosen, path)
+
+    attempts = verified_pick(case, tolerance, attempt, model)
+    answer = attempts[-1]
+    chosen, path = answer.result
+    result = read_run(path)
+    result.attrs.update(
+        tolerance_mode="verified", measured_error=answer.measured,
+        expected_error=answer.calibration * answer.model_error,
+        expected_cost_s=model.expected_cost(answer.drivers),
+        tolerance_error_terms=json.dumps(model.terms(answer.drivers)),
+        tolerance_attempts=json.dumps([a.record() for a in attempts]),
+        error_model=json.dumps({**model.provenance, "calibration": answer.calibration}))
+    with atomic_path(out) as tmp:
+        result.to_netcdf(tmp, engine="netcdf4")
+    for other in out.parent.glob(f"{out.stem}.attempt*{out.suffix}"):
+        other.unlink()
+    return attempts

@@ -126,8 +126,17 @@ RUN_ATTRIBUTES: Mapping[str, Attribute] = MappingProxyType({a.name: a for a in (
     Attribute("dt", float, "time step used [tau]"),
     Attribute("sound_speed", float, "sound speed c used [h/tau]"),
     Attribute("tolerance", float, "requested relative error of suspsim run --tolerance [1]"),
+    Attribute("tolerance_mode", str, "how the set-up was chosen: verified (runs measured "
+              "against the exact solution until one met the tolerance) or bound (the inflated "
+              "error model alone)"),
     Attribute("expected_error", float, "error model's expected error bound (error + 2 "
-              "standard errors) of the chosen set-up [1]"),
+              "standard errors) of the chosen set-up: inflated (bound) or calibrated on the "
+              "earlier attempts (verified) [1]"),
+    Attribute("measured_error", float, "error bound (error + 2 standard errors) measured "
+              "against the flow's exact solution [1]"),
+    Attribute("tolerance_attempts", str, "runs of a verified --tolerance, in order (JSON: "
+              "settings, model_error [1], calibration [1], measured_error [1] or null for a "
+              "blow-up, cpu_time_s [s])"),
     Attribute("expected_cost_s", float, "cost model's expected CPU time of one thread [s]"),
     Attribute("tolerance_settings", str, "numerical settings chosen for the tolerance (JSON: "
               "resolution h/dx [1], dt_coefficient [1], wi_target [1], side or width [h], "
