@@ -112,6 +112,18 @@ COUETTE = {"dimension": 2, "box": [10, 10], "number_density": 6.25,
            "flow": {"type": "couette", "shear_rate": 0.1}, "run": {"strain": 4}}
 
 
+def couette_series(scene, unit_means, per_unit=20):
+    """Run data of a Couette ``scene`` whose shear stress is μ(γ̇)γ̇ × ``unit_means[k]`` over
+    strain unit k (counted from 0, the first one the transient)."""
+    rate = scene.flow.shear_rate
+    stress = float(scene.fluid.law.viscosity(rate)) * rate
+    strain = np.arange(1, per_unit * len(unit_means) + 1) / per_unit
+    unit = np.ceil(strain - 1e-9).astype(int) - 1
+    return {"time": strain / rate, "strain": strain,
+            "shear_stress": stress * np.asarray(unit_means)[unit],
+            "viscosity": stress / rate * np.mean(unit_means[1:]), "viscosity_stderr": 0.0}
+
+
 class FakeRun:
     """Stand-in for run_scene: writes a run file whose viscosity is the law's × (1 + e), e the
     next of ``errors`` (the last one repeats; None: a blow-up, "stop": a run interrupted by a
@@ -127,8 +139,7 @@ class FakeRun:
             raise NumericalError("density error 0.31 exceeds run.max_density_error")
         if error == "stop":
             raise RunInterrupted("stopped by signal 15", 15)
-        mu = float(scene.fluid.law.viscosity(scene.flow.shear_rate))
-        write_run(path, {"viscosity": mu * (1 + error), "viscosity_stderr": 0.0},
+        write_run(path, couette_series(scene, np.full(4, 1 + error)),
                   {"wall_time_s": 1.0, "completed": 1, "reynolds_number": 0.1, "mach_number": 0.01,
                    "particle_steps_per_s": 1e6, **extra_attrs}, scene)
         return path
@@ -185,6 +196,16 @@ def test_measured_error_of_a_channel_is_the_profile_error(tmp_path):
     peak = abs(exact).max()
     rms = math.sqrt(((0.03 * exact) ** 2).mean())
     assert tl.measured_error(scene, read_run(path)) == pytest.approx(rms / peak)
+
+
+def test_measured_error_of_a_couette_is_that_of_the_strain_unit_means(tmp_path):
+    """As the cases measure it: unit means 1.01, 1.03, 1.02 after one unit of transient
+    (which reads 1.5, discarded) → |1.02 − 1| + 2 × 0.01/√3."""
+    scene = scene_from_dict({**COUETTE, "run": {"strain": 4, "transient": 1}})
+    path = tmp_path / "c.nc"
+    write_run(path, couette_series(scene, [1.5, 1.01, 1.03, 1.02]),
+              {"wall_time_s": 1.0, "completed": 1}, scene)
+    assert tl.measured_error(scene, read_run(path)) == pytest.approx(0.02 + 0.02 / math.sqrt(3))
 
 
 def test_cli_tolerance_names_the_missed_attempts(tmp_path, monkeypatch, capsys):

@@ -147,8 +147,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s")
     try:
-        ds = check(args[0], float(args[1]), max_runs=int(args[3]) if len(args) == 4 else MAX_COMPARISONS,
-                   verified=verified)
+        ds = check(args[0], float(args[1]), verified=verified,
+                   max_runs=int(args[3]) if len(args) == 4 else MAX_COMPARISONS)
     except InputError as err:
         # the picker refuses, or no attempt met the tolerance: nothing to compare
         print(f"error: {err}", file=sys.stderr)

@@ -38,6 +38,7 @@ from os import PathLike
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+import numpy as np
 import xarray as xr
 
 from suspsim.convergence.cases import Axis, Case, _channel_box, snapped_resolution
@@ -167,13 +168,28 @@ def choose(scene: Scene, tolerance: float, model: ErrorModel | None = None
 
 def measured_error(scene: Scene, result: xr.Dataset) -> float:
     """Error bound [1] of a finished run ``result`` of ``scene`` against the flow's exact
-    solution, as the cases measure it (:mod:`.cases`): Couette |η/μ(γ̇) − 1| + 2 standard
-    errors (the run's block-average ``viscosity_stderr``); Poiseuille the L2/peak error of the
-    steady-window ``velocity_profile`` against the split-force profile of the law (SPEC §6.2)."""
+    solution, as the cases measure it (:mod:`.cases`, the error model's training data):
+
+    - Couette: the shear stress samples of each whole strain unit after ``run.transient``,
+      averaged per unit and divided by μ(γ̇)γ̇; |mean − 1| + 2 standard errors of the unit means
+      (:func:`~suspsim.validation.flows.couette_viscosity_ratio`). With fewer than two whole
+      units, the run's ``viscosity`` and its block-average ``viscosity_stderr``;
+    - Poiseuille: the L2/peak error of the steady-window ``velocity_profile`` against the
+      split-force profile of the law (SPEC §6.2)."""
     if scene.flow.type == "couette":
-        mu = float(scene.fluid.law.viscosity(scene.flow.shear_rate))
-        stderr = float(result["viscosity_stderr"]) / mu
-        return (abs(float(result["viscosity"]) / mu - 1.0)
+        rate = scene.flow.shear_rate
+        expected = float(scene.fluid.law.viscosity(rate)) * rate
+        since = result["strain"].values - scene.run.transient
+        units = int(math.floor(scene.run.length - scene.run.transient + 1e-9))
+        unit = np.ceil(since - 1e-9).astype(int) - 1
+        stress = result["shear_stress"].values
+        means = [stress[unit == k].mean() / expected for k in range(units)
+                 if np.any(unit == k)]
+        if len(means) >= 2:
+            return (abs(float(np.mean(means)) - 1.0)
+                    + STDERR_FACTOR * float(np.std(means, ddof=1) / math.sqrt(len(means))))
+        stderr = float(result["viscosity_stderr"]) * rate / expected
+        return (abs(float(result["viscosity"]) * rate / expected - 1.0)
                 + STDERR_FACTOR * (stderr if math.isfinite(stderr) else 0.0))
     y = result["y"].values
     reference = split_force_poiseuille_profile(
