@@ -378,6 +378,9 @@ CASES: dict[str, AnyCase] = {case.name: case for case in (
     # the blind held-out set of docs/figures/error_model/run_holdout_blind_5.sh (the verified
     # picker): never fitted on
     papanastasiou_couette(6.0, 2), bingham_poiseuille(8.0, 3), newtonian_poiseuille(2, 1.0),
+    # the blind held-out set of docs/figures/error_model/run_holdout_blind_6.sh: never fitted on
+    papanastasiou_couette(45.0, 2), bingham_poiseuille(2.5, 3), bingham_poiseuille(9.0, 3),
+    newtonian_poiseuille(3, 0.5),
     dst_flow_curve_point(0.54, 2.5),
     dst_flow_curve_point(0.50, 1.0))}
 
