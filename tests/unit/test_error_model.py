@@ -23,13 +23,15 @@ def test_packaged_model_loads_with_provenance():
     model = em.load_model()
     assert model.inflation >= 1.0
     assert {"datasets", "date", "command", "training_cases"} <= set(model.provenance)
-    # the blind held-out sets (docs/figures/error_model/run_holdout_blind_3.sh, _4, _5); the
-    # earlier ones (run_holdout_blind.sh, run_holdout_blind_2.sh) are training data
+    # the blind held-out sets (docs/figures/error_model/run_holdout_blind_3.sh, _4, _5, _6);
+    # the earlier ones (run_holdout_blind.sh, run_holdout_blind_2.sh) are training data
     held_out = {"couette_papanastasiou_bn3_2d", "poiseuille_bingham4_3d",
                 "poiseuille_newtonian_re0.25_2d", "couette_papanastasiou_bn20_2d",
                 "poiseuille_bingham6_3d", "poiseuille_newtonian_re0.25_3d",
                 "couette_papanastasiou_bn6_2d", "poiseuille_bingham8_3d",
-                "poiseuille_newtonian_re1_2d"}
+                "poiseuille_newtonian_re1_2d", "couette_papanastasiou_bn45_2d",
+                "poiseuille_bingham2.5_3d", "poiseuille_bingham9_3d",
+                "poiseuille_newtonian_re0.5_3d"}
     assert not held_out & set(model.provenance["training_cases"])
     assert {"couette_papanastasiou_bn9.9_2d", "poiseuille_bingham7_3d",
             "poiseuille_newtonian_re1_3d", "couette_papanastasiou_bn30_3d",

@@ -46,8 +46,9 @@ COST_RATIO = 2.0
 #: COST_RATIO [1] [choice]: 1.5, about twice the cost model's rms log error (0.23) above the
 #: cost at which a configuration meeting the tolerance would fail the check.
 COST_SLACK = 1.5
-#: Default cap on the comparison runs.
-MAX_COMPARISONS = 12
+#: Default cap on the comparison runs: 40, above the 14 distinct runs the sixth held-out
+#: pass's 3D Newtonian channel had below its threshold (its cap of 12 hid a cheaper one).
+MAX_COMPARISONS = 40
 _NUMERICS = ("dt_coefficient", "wi_target")
 
 

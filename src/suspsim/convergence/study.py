@@ -54,8 +54,9 @@ def configurations(case: AnyCase, values: Mapping[str, Sequence[Any]],
     """The overrides of each configuration (``{}`` is the case's defaults), without repeats.
 
     ``tolerance: [ε, ...]`` among the values adds, for each ε, the configuration the error
-    model's picker chooses for that relative error (:func:`.picker.pick`; an unreachable
-    ε is an InputError), so a study measures what ``suspsim run --tolerance`` would run."""
+    model's inflated bound picks for that relative error (:func:`.picker.pick`; an unreachable
+    ε is an InputError), so a study measures what ``suspsim run --tolerance --no-verify``
+    would run (the verified mode's attempts depend on the runs: :mod:`.holdout`)."""
     if sweep not in SWEEPS:
         raise InputError("speed_error", f"sweep must be one of {', '.join(SWEEPS)}, not '{sweep}'",
                          key="speed_error.sweep")
