@@ -31,8 +31,9 @@ its cases and run with the packaged model of 2026-12-03; CPU seconds of one thre
   smaller step instead of a wider channel.
 
 Slow; ``SUSPSIM_REDUCED=1`` (CI) compares with at most 3 runs instead of 40, which can miss the
-cheaper configuration that fails a check. A failure of the cost criterion reports xfail with its
-reason while it fails; a fix belongs in the model or the picker, not in this test.
+cheaper configuration that fails a check, and skips the Bn = 8 channel (20-32 s of attempts).
+A failure of the cost criterion reports xfail with its reason while it fails; a fix belongs in
+the model or the picker, not in this test.
 """
 import os
 
@@ -42,6 +43,8 @@ from suspsim.convergence.holdout import COST_RATIO, MAX_COMPARISONS, check
 
 REDUCED = os.environ.get("SUSPSIM_REDUCED") == "1"
 COMPARISONS = 3 if REDUCED else MAX_COMPARISONS
+#: Cases whose attempts took more than 15 s of CPU in the blind pass (full size only).
+SLOW_CASES = {"poiseuille_bingham8_3d"}
 
 CASES = [
     ("couette_papanastasiou_bn6_2d", 0.05, None),
@@ -67,6 +70,8 @@ CASES = [
 @pytest.mark.slow
 @pytest.mark.parametrize("case, tolerance, known_failure", CASES)
 def test_tolerance_meets_error_at_near_least_cost(case, tolerance, known_failure):
+    if REDUCED and case in SLOW_CASES:
+        pytest.skip("its attempts took 20-32 s of CPU in the blind pass (full size only)")
     ds = check(case, tolerance, max_runs=COMPARISONS)
     print(case, tolerance, {k: ds.attrs[k] for k in (
         "attempts", "expected_error", "picked_error_bound", "paid_cpu_time",

@@ -356,8 +356,122 @@ def dst_flow_curve_point(phi: float = 0.54, stress: float = 2.5,
                         phi, stress, alpha)
 
 
-#: Any kind of case: an SPH fluid case or a DST flow-curve point.
-AnyCase = Case | DSTPointCase
+@dataclass(frozen=True)
+class DSTChannelCase(_Settings):
+    """Channel flow of the local Wyart–Cates model (SPEC §5.7, α = 0) at ``phi`` and driving
+    force F H/σ* = ``force_ratio``, the momentum protocol of
+    :func:`suspsim.dst.channel_study.channel_sweep` (start from rest with f at its local steady
+    value, one momentum time ρ L_y²/η(f = 0)): error L2/peak of the particle velocities against
+    the local model's ODE profile, as the validation test. Axes: ``n_y`` (particles across the
+    gap), ``n_x`` and ``density`` ρ (the momentum time, so the steps, go with ρ)."""
+
+    name: str
+    description: str
+    reference: str
+    axes: tuple[Axis, ...]
+    phi: float
+    force_ratio: float
+
+    def _channel(self, settings, threads, lattice=None):
+        from suspsim.dst.channel_study import channel_sweep
+
+        lattice = lattice or (int(settings["n_x"]), int(settings["n_y"]))
+        return channel_sweep(self.phi, [self.force_ratio], lattice=lattice, threads=threads,
+                             density=float(settings["density"])).isel(force_ratio=0)
+
+    def warm_up(self, settings: Mapping[str, Any], threads: int) -> None:
+        """A 13 × 6 channel (the smallest periodic lattice), so compiled code is loaded."""
+        self._channel(settings, threads, lattice=(13, 6))
+
+    def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
+        """Run and read the channel of ``settings`` (set-up and run are not timed apart)."""
+        t0 = time.perf_counter()
+        flow = self._channel(settings, threads)
+        return Run(Reading(float(flow["velocity_l2_error"]), float("nan")),
+                   int(flow.attrs["n_particles"]), int(flow["steps"]), float("nan"),
+                   float(flow["sound_speed"]), float("nan"), float(settings["n_y"]), 0.0,
+                   time.perf_counter() - t0)
+
+
+def dst_channel(phi: float = 0.54, force_ratio: float = 10.0) -> DSTChannelCase:
+    """The validation's channel: φ = 0.54, F H/σ* = 10 (a shear-thickened wall layer)."""
+    axes = (Axis("n_y", 20, "1", "fluid particles across the gap (the resolution)"),
+            Axis("n_x", 14, "1", "fluid particles along the periodic direction"),
+            Axis("density", 1.0, "sigma_star L_y2 eta_s-2", "density rho, which sets the "
+                 "momentum time rho L_y^2/eta(0) run"))
+    return DSTChannelCase(f"dst_channel_phi{phi:g}_force{force_ratio:g}",
+                          f"DST channel (2D, local), phi = {phi:g}, F H/sigma* = {force_ratio:g}",
+                          "local Wyart-Cates channel ODE (SPEC 5.7)", axes, phi, force_ratio)
+
+
+@dataclass(frozen=True)
+class DiluteSuspensionCase(_Settings):
+    """One sphere (φ ≪ 1) in a sheared periodic box of the Newtonian matrix of
+    :mod:`suspsim.validation.suspension`: error η_r/η_BG − 1 against Batchelor & Green's
+    1 + 2.5φ + 5.2φ² at the packing's φ, with the standard error of the strain-unit means.
+    The reference is not exact: one sphere meets only its periodic images, so its φ² term
+    differs from 5.2φ² by about φ² (0.1 % of η_r at φ = 0.03), the floor of what this case can
+    resolve. Axes: ``radius`` a [h] (the sphere's resolution), ``units`` (strain units averaged
+    after one of transient), ``wi_target`` and ``dt_coefficient``; the box side follows from a
+    and φ (one sphere), rounded to whole lattice spacings (the packing keeps φ exact, so a
+    moves by up to a third of a spacing)."""
+
+    name: str
+    description: str
+    reference: str
+    axes: tuple[Axis, ...]
+    phi: float
+
+    def _scene(self, settings):
+        from suspsim.validation.suspension import NUMBER_DENSITY, suspension_scene
+
+        radius = float(settings["radius"])
+        spacing = NUMBER_DENSITY ** (-1.0 / 3.0)
+        box = spacing * round((4.0 * math.pi / 3.0 * radius ** 3 / self.phi) ** (1.0 / 3.0)
+                              / spacing)
+        return suspension_scene(phi=self.phi, radius=radius, box=box,
+                                strain=1.0 + int(settings["units"]), overrides={
+                                    "numerics.wi_target": float(settings["wi_target"]),
+                                    "numerics.dt_viscous_coefficient":
+                                        float(settings["dt_coefficient"])})
+
+    def warm_up(self, settings: Mapping[str, Any], threads: int) -> None:
+        """Two steps of the same scene, so compiled code is loaded."""
+        from suspsim.sph.simulation import Simulation
+
+        Simulation(self._scene(settings), threads=threads).advance(WARM_UP_STEPS)
+
+    def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
+        """Build, run and read the suspension of ``settings``."""
+        from suspsim.rheology.suspension import batchelor
+        from suspsim.sph.simulation import Simulation
+
+        t0 = time.perf_counter()
+        scene = self._scene(settings)
+        sim = Simulation(scene, threads=threads)
+        t1 = time.perf_counter()
+        reading = couette_viscosity_ratio(sim, transient=1.0, units=int(settings["units"]))
+        reference = float(batchelor(sim.packing_phi))
+        return Run(Reading((1.0 + reading.value) / reference - 1.0, reading.stderr / reference),
+                   sim.n_particles, sim.step_count, sim.dt, sim.sound_speed,
+                   scene.number_density, scene.number_density ** (1.0 / 3.0), t1 - t0,
+                   time.perf_counter() - t1)
+
+
+def dilute_suspension(phi: float = 0.03) -> DiluteSuspensionCase:
+    """One sphere at ``phi`` (the Einstein test's 0.03: a = 2.5 h in a 12.5 h box)."""
+    axes = (Axis("radius", 2.5, "h", "sphere radius a in support radii (its resolution)"),
+            Axis("units", 4, "1", "strain units averaged after one of transient"),
+            Axis("wi_target", 1e-3, "1", "mu gdot/(rho c^2) of the sound speed"),
+            Axis("dt_coefficient", 0.05, "1", "C in the viscous step limit C rho h^2/mu_max"))
+    return DiluteSuspensionCase(f"suspension_dilute_phi{phi:g}",
+                                f"one sphere in a periodic box (3D), phi = {phi:g}",
+                                "Batchelor-Green 1 + 2.5 phi + 5.2 phi^2 (approximate: one "
+                                "sphere meets only its images)", axes, phi)
+
+
+#: Any kind of case: an SPH fluid case, a DST flow-curve point or channel, a dilute suspension.
+AnyCase = Case | DSTPointCase | DSTChannelCase | DiluteSuspensionCase
 
 #: The registered cases by name.
 CASES: dict[str, AnyCase] = {case.name: case for case in (
@@ -382,7 +496,7 @@ CASES: dict[str, AnyCase] = {case.name: case for case in (
     papanastasiou_couette(45.0, 2), bingham_poiseuille(2.5, 3), bingham_poiseuille(9.0, 3),
     newtonian_poiseuille(3, 0.5),
     dst_flow_curve_point(0.54, 2.5),
-    dst_flow_curve_point(0.50, 1.0))}
+    dst_flow_curve_point(0.50, 1.0), dst_channel(0.54, 10.0), dilute_suspension(0.03))}
 
 
 def get_case(name: str) -> AnyCase:

@@ -7,7 +7,7 @@ from typing import Sequence
 import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 #: Colours of the swept axes (base in black); other axes cycle through the rest.
 _AXIS_COLOURS = {"base": "black", "resolution": "tab:blue", "dt_coefficient": "tab:orange",
@@ -56,6 +56,9 @@ def plot_pareto(datasets: Sequence[xr.Dataset], *, columns: int = 3) -> Figure:
         ax.set_xscale("log")
         ax.set_yscale("log")
         for axis in (ax.xaxis, ax.yaxis):
+            # 1-2-5 labels, so an axis spanning less than a decade still has some
+            axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
             axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("CPU time, one thread [s]")
         ax.set_ylabel("error against the reference [1]")
