@@ -213,8 +213,9 @@ def run_verified(scene: Scene, tolerance: float, out: str | PathLike, *, resume:
     ``tolerance_stress_scale``, ``tolerance_error_terms``, ``tolerance_attempts`` (every
     attempt's settings, model error, calibration, measured error and CPU time) and
     ``error_model``; the missed attempts' files are removed. With ``resume`` a finished attempt
-    file of the same settings is measured again rather than re-run and an interrupted one
-    resumes from its checkpoint (the attempts are deterministic). An InputError when no
+    file of the same settings is measured again rather than re-run (its recorded CPU time is
+    then that of reading it) and an interrupted one resumes from its checkpoint (the attempts
+    are deterministic). An InputError when no
     attempt meets the tolerance (the files of the attempts stay)."""
     run = run or run_scene
     model = model or load_model()
