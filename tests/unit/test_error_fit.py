@@ -26,7 +26,7 @@ def synthetic_points(rng):
                        0.0 if flow == "couette" else rng.uniform(0.0, 5.0), 0 if flow == "couette"
                        else 2 * int(rng.integers(5, 20)))
         model = em.ErrorModel(TRUE, EXPONENTS, 1.0, {}, {})
-        points.append((d, sum(model.terms(d).values())))
+        points.append((d, model.model_error(d)))
     return points
 
 
@@ -84,7 +84,7 @@ def test_blow_up_caps_the_domain_even_where_the_finished_runs_fit_badly(monkeypa
     model = em.ErrorModel(TRUE, EXPONENTS, 1.0, {}, {})
     poor = em.Drivers(**{**d0.__dict__, "courant": 0.1})
     blown = em.Drivers(**{**d0.__dict__, "courant": 0.8})
-    records = points + [(poor, 10 * sum(model.terms(poor).values())), (blown, math.nan)]
+    records = points + [(poor, 10 * model.model_error(poor)), (blown, math.nan)]
     fitted = fit_known_exponents(monkeypatch, records)
     assert fitted.provenance["unsafe_courant"] == {"couette_newtonian_3d": pytest.approx(0.8)}
 
@@ -97,8 +97,8 @@ def test_timestep_outlier_caps_the_domain(monkeypatch):
     model = em.ErrorModel(TRUE, EXPONENTS, 1.0, {}, {})
     calm = em.Drivers(**{**d0.__dict__, "courant": 0.1})
     wild = em.Drivers(**{**d0.__dict__, "courant": 0.9})
-    records = points + [(calm, sum(model.terms(calm).values())),
-                        (wild, 20 * sum(model.terms(wild).values()))]
+    records = points + [(calm, model.model_error(calm)),
+                        (wild, 20 * model.model_error(wild))]
     fitted = fit_known_exponents(monkeypatch, records)
     assert fitted.provenance["unsafe_courant"] == {"couette_newtonian_3d": pytest.approx(0.9)}
     assert fitted.bounds["courant_couette_newtonian_3d"][1] < 0.9
@@ -196,7 +196,7 @@ def test_blow_up_inside_the_calm_range_shortens_every_time_step_range(monkeypatc
     small = em.Drivers(**{**d0.__dict__, "courant": 0.05})
     blown = em.Drivers(**{**d0.__dict__, "courant": 0.9 * calm_edge})
     records = [(d, b, 1e-6 * d.work, "a") for d, b in points] + [
-        (small, sum(model.terms(small).values()), 1e-6 * small.work, "b"),
+        (small, model.model_error(small), 1e-6 * small.work, "b"),
         (blown, math.nan, math.nan, "b")]
     fitted = ef.fit_points(records, cross_validate=False)
     margin = fitted.provenance["courant_margin"]

@@ -28,7 +28,7 @@ CASE = "couette_newtonian_3d"
 def rows():
     """(settings, drivers, uninflated model error, expected cost), cheapest first."""
     model = em.load_model()
-    return sorted(((s, d, sum(model.terms(d).values()), c)
+    return sorted(((s, d, model.model_error(d), c)
                    for s, d, _, c in pk.evaluate(get_case(CASE), model)), key=lambda r: r[3])
 
 
@@ -42,8 +42,8 @@ def runner(factor, blow_up_above=math.inf, log=None):
         d = em.drivers(case.build(settings), settings)
         if log is not None:
             log.append(d)
-        measured = math.inf if d.courant >= blow_up_above else factor * sum(
-            model.terms(d).values())
+        measured = (math.inf if d.courant >= blow_up_above
+                    else factor * model.model_error(d))
         return measured, model.expected_cost(d), None
     return run
 

@@ -28,7 +28,7 @@ def main() -> None:
     by_case = collections.defaultdict(list)
     for d, bound, _, case in points:
         if math.isfinite(bound) and model.in_domain(d):
-            by_case[case].append((model.expected_cost(d), bound / sum(model.terms(d).values())))
+            by_case[case].append((model.expected_cost(d), bound / model.model_error(d)))
     largest = []
     for case, rows in sorted(by_case.items()):
         rows.sort()

@@ -41,7 +41,7 @@ def candidates(points, case, fold, model):
         if c != case or not fold.in_domain(d) or inflation_class(d) not in fold.class_inflation:
             continue
         cost = fold.expected_cost(d)
-        rows.append(({"run": i}, d, sum(fold.terms(d).values()), cost,
+        rows.append(({"run": i}, d, fold.model_error(d), cost,
                      bound if math.isfinite(bound) else math.inf,
                      cpu if math.isfinite(cpu) else cost, model.class_inflation[
                          inflation_class(d)]))

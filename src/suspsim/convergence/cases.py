@@ -30,8 +30,8 @@ t_ν = W²/ν, the last t_ν averaged. Bingham (Papanastasiou,
 (``reference.poiseuille``), started from the Newtonian profile of equal flow rate, run 0.8 t_pl and
 the last 0.2 t_pl averaged, t_pl = W²/ν_pl. Error: L2/peak of the averaged profile.
 
-DST flow-curve point (SPEC §1.3, §5.4; :class:`DSTPointCase`): the 2D Wyart–Cates solver
-under stress control; error ⟨γ̇⟩/γ̇_WC − 1.
+The registry :data:`CASES` also holds the DST cases (:mod:`.dst_cases`) and the dilute
+suspension (:mod:`.suspension_cases`); :mod:`.case_base` holds what every kind shares.
 """
 from __future__ import annotations
 
@@ -40,6 +40,10 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
+from suspsim.convergence.case_base import WARM_UP_STEPS, Axis, CaseSettings, Run
+from suspsim.convergence.dst_cases import (DSTChannelCase, DSTPointCase, dst_channel,
+                                           dst_flow_curve_point)
+from suspsim.convergence.suspension_cases import DiluteSuspensionCase, dilute_suspension
 from suspsim.errors import InputError
 from suspsim.reference.poiseuille import force_density_for_bingham
 from suspsim.rheology.laws import make_law
@@ -60,21 +64,8 @@ CHANNEL_REYNOLDS = 0.1
 #: Kinematic plastic viscosity of the Bingham channel [h² τ⁻¹] (the validation's μ_pl = 20 at
 #: n = 4.096).
 BINGHAM_NU = 20.0 / 4.096
-#: Steps of the untimed warm-up that loads the compiled code [choice].
-WARM_UP_STEPS = 2
 #: Default lattice jitter [spacings] (a start off the lattice, as the validations).
 JITTER = 0.1
-
-
-@dataclass(frozen=True)
-class Axis:
-    """A numerical setting a study may sweep: ``name``, its ``default``, ``unit`` (UDUNITS or
-    "1") and what it is."""
-
-    name: str
-    default: Any
-    unit: str
-    description: str
 
 
 def _common_axes(resolution: float) -> tuple[Axis, ...]:
@@ -86,43 +77,8 @@ def _common_axes(resolution: float) -> tuple[Axis, ...]:
             Axis("jitter", JITTER, "1", "random displacement of the start lattice [spacings]"))
 
 
-class _Settings:
-    """The axes' defaults and their validated overrides (shared by every kind of case)."""
-
-    name: str
-    axes: tuple[Axis, ...]
-
-    def settings(self, overrides: Mapping[str, Any] | None = None) -> dict[str, Any]:
-        """The axes' defaults updated by ``overrides``; an unknown axis is an InputError."""
-        names = {axis.name: axis for axis in self.axes}
-        out = {name: axis.default for name, axis in names.items()}
-        for key, value in (overrides or {}).items():
-            if key not in names:
-                raise InputError(f"case {self.name}", f"unknown setting '{key}'; the case sweeps "
-                                 f"{', '.join(names)}", key=key)
-            out[key] = value
-        return out
-
-
 @dataclass(frozen=True)
-class Run:
-    """What :meth:`Case.execute` measured: the error ``reading`` and the run's size
-    (particles, steps, time step [τ], sound speed [h τ⁻¹], number density [h⁻ᵈ] and q after
-    snapping; NaN where the solver has none) and its set-up and run wall times [s]."""
-
-    reading: Reading
-    n_particles: int
-    n_steps: int
-    dt: float
-    sound_speed: float
-    number_density: float
-    resolution_used: float
-    setup_time: float
-    run_time: float
-
-
-@dataclass(frozen=True)
-class Case(_Settings):
+class Case(CaseSettings):
     """An SPH fluid case: ``scene(settings)`` → scene dict, ``measure(sim, settings)`` →
     :class:`~suspsim.validation.flows.Reading` of the error on a fresh simulation
     (``restart(sim)`` first replaces the start where the case needs one)."""
@@ -297,179 +253,6 @@ def bingham_poiseuille(bingham: float = 1.0, dim: int = 3) -> Case:
                 restart=start_from_newtonian_profile)
 
 
-@dataclass(frozen=True)
-class DSTPointCase(_Settings):
-    """A stress-controlled Wyart–Cates flow-curve point of the 2D DST solver
-    (:func:`suspsim.dst.study.flow_curve`, scaled units η_s = σ* = L_y = 1, seed 002's
-    φ_m, φ_0, β and K_f): error ⟨γ̇⟩/γ̇_WC(σ_in) − 1 against the steady Wyart–Cates curve
-    (SPEC §1.3), with the batch-means standard error of ⟨γ̇⟩. Axes: the lattice (``n_y``
-    particles across the gap, the resolution; ``n_x`` along it), ``epsilon`` (the density
-    ε = K_f γ̇ ρ L_y²/η, which sets Re and the viscous step count) and the equilibration and
-    averaging strains."""
-
-    name: str
-    description: str
-    reference: str
-    axes: tuple[Axis, ...]
-    phi: float
-    stress: float
-    alpha: float
-
-    def _point(self, settings, threads, equilibration, averaging):
-        from suspsim.dst.study import flow_curve
-
-        return flow_curve(self.phi, [self.stress], alpha=self.alpha,
-                          lattice=(int(settings["n_x"]), int(settings["n_y"])), threads=threads,
-                          epsilon=float(settings["epsilon"]), equilibration_strain=equilibration,
-                          averaging_strain=averaging).isel(stress=0)
-
-    def warm_up(self, settings: Mapping[str, Any], threads: int) -> None:
-        """A run of 0.02 strain on the same lattice, so compiled code is loaded."""
-        self._point(settings, threads, 0.01, 0.01)
-
-    def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
-        """Run and read the point of ``settings`` (set-up and run are not timed apart)."""
-        t0 = time.perf_counter()
-        point = self._point(settings, threads, float(settings["equilibration_strain"]),
-                            float(settings["averaging_strain"]))
-        rate = float(point["wyart_cates_shear_rate"])
-        reading = Reading(float(point["shear_rate"]) / rate - 1.0,
-                          float(point["shear_rate_stderr"]) / rate)
-        n_y = int(settings["n_y"])
-        return Run(reading, int(point.attrs["n_particles"]), int(point["steps"]),
-                   float(point["time_step"]), float(point["sound_speed"]), float("nan"),
-                   float(n_y), 0.0, time.perf_counter() - t0)
-
-
-def dst_flow_curve_point(phi: float = 0.54, stress: float = 2.5,
-                         alpha: float = 0.02) -> DSTPointCase:
-    """φ = 0.54 at σ_in = 2.5 σ* lies on the unstable branch (σ_β = 0.76, σ_α = 3.92);
-    α = 0.02 is seed 002's strong non-locality scaled."""
-    axes = (Axis("n_y", 20, "1", "fluid particles across the gap (the resolution)"),
-            Axis("n_x", 14, "1", "fluid particles along the periodic direction"),
-            Axis("epsilon", 0.1, "1", "K_f gdot rho L_y^2/eta, which sets the density"),
-            Axis("equilibration_strain", 1.5, "1", "strain gdot_WC t discarded"),
-            Axis("averaging_strain", 1.5, "1", "strain gdot_WC t averaged"))
-    return DSTPointCase(f"dst_point_phi{phi:g}_sigma{stress:g}_alpha{alpha:g}",
-                        f"DST point (2D), phi = {phi:g}, sigma = {stress:g}, alpha = {alpha:g}",
-                        "steady Wyart-Cates curve (SPEC 1.3)", axes,
-                        phi, stress, alpha)
-
-
-@dataclass(frozen=True)
-class DSTChannelCase(_Settings):
-    """Channel flow of the local Wyart–Cates model (SPEC §5.7, α = 0) at ``phi`` and driving
-    force F H/σ* = ``force_ratio``, the momentum protocol of
-    :func:`suspsim.dst.channel_study.channel_sweep` (start from rest with f at its local steady
-    value, one momentum time ρ L_y²/η(f = 0)): error L2/peak of the particle velocities against
-    the local model's ODE profile, as the validation test. Axes: ``n_y`` (particles across the
-    gap), ``n_x`` and ``density`` ρ (the momentum time, so the steps, go with ρ)."""
-
-    name: str
-    description: str
-    reference: str
-    axes: tuple[Axis, ...]
-    phi: float
-    force_ratio: float
-
-    def _channel(self, settings, threads, lattice=None):
-        from suspsim.dst.channel_study import channel_sweep
-
-        lattice = lattice or (int(settings["n_x"]), int(settings["n_y"]))
-        return channel_sweep(self.phi, [self.force_ratio], lattice=lattice, threads=threads,
-                             density=float(settings["density"])).isel(force_ratio=0)
-
-    def warm_up(self, settings: Mapping[str, Any], threads: int) -> None:
-        """A 13 × 6 channel (the smallest periodic lattice), so compiled code is loaded."""
-        self._channel(settings, threads, lattice=(13, 6))
-
-    def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
-        """Run and read the channel of ``settings`` (set-up and run are not timed apart)."""
-        t0 = time.perf_counter()
-        flow = self._channel(settings, threads)
-        return Run(Reading(float(flow["velocity_l2_error"]), float("nan")),
-                   int(flow.attrs["n_particles"]), int(flow["steps"]), float("nan"),
-                   float(flow["sound_speed"]), float("nan"), float(settings["n_y"]), 0.0,
-                   time.perf_counter() - t0)
-
-
-def dst_channel(phi: float = 0.54, force_ratio: float = 10.0) -> DSTChannelCase:
-    """The validation's channel: φ = 0.54, F H/σ* = 10 (a shear-thickened wall layer)."""
-    axes = (Axis("n_y", 20, "1", "fluid particles across the gap (the resolution)"),
-            Axis("n_x", 14, "1", "fluid particles along the periodic direction"),
-            Axis("density", 1.0, "sigma_star L_y2 eta_s-2", "density rho, which sets the "
-                 "momentum time rho L_y^2/eta(0) run"))
-    return DSTChannelCase(f"dst_channel_phi{phi:g}_force{force_ratio:g}",
-                          f"DST channel (2D, local), phi = {phi:g}, F H/sigma* = {force_ratio:g}",
-                          "local Wyart-Cates channel ODE (SPEC 5.7)", axes, phi, force_ratio)
-
-
-@dataclass(frozen=True)
-class DiluteSuspensionCase(_Settings):
-    """One sphere (φ ≪ 1) in a sheared periodic box of the Newtonian matrix of
-    :mod:`suspsim.validation.suspension`: error η_r/η_BG − 1 against Batchelor & Green's
-    1 + 2.5φ + 5.2φ² at the packing's φ, with the standard error of the strain-unit means.
-    The reference is not exact: one sphere meets only its periodic images, so its φ² term
-    differs from 5.2φ² by about φ² (0.1 % of η_r at φ = 0.03), the floor of what this case can
-    resolve. Axes: ``radius`` a [h] (the sphere's resolution), ``units`` (strain units averaged
-    after one of transient), ``wi_target`` and ``dt_coefficient``; the box side follows from a
-    and φ (one sphere), rounded to whole lattice spacings (the packing keeps φ exact, so a
-    moves by up to a third of a spacing)."""
-
-    name: str
-    description: str
-    reference: str
-    axes: tuple[Axis, ...]
-    phi: float
-
-    def _scene(self, settings):
-        from suspsim.validation.suspension import NUMBER_DENSITY, suspension_scene
-
-        radius = float(settings["radius"])
-        spacing = NUMBER_DENSITY ** (-1.0 / 3.0)
-        box = spacing * round((4.0 * math.pi / 3.0 * radius ** 3 / self.phi) ** (1.0 / 3.0)
-                              / spacing)
-        return suspension_scene(phi=self.phi, radius=radius, box=box,
-                                strain=1.0 + int(settings["units"]), overrides={
-                                    "numerics.wi_target": float(settings["wi_target"]),
-                                    "numerics.dt_viscous_coefficient":
-                                        float(settings["dt_coefficient"])})
-
-    def warm_up(self, settings: Mapping[str, Any], threads: int) -> None:
-        """Two steps of the same scene, so compiled code is loaded."""
-        from suspsim.sph.simulation import Simulation
-
-        Simulation(self._scene(settings), threads=threads).advance(WARM_UP_STEPS)
-
-    def execute(self, settings: Mapping[str, Any], threads: int) -> Run:
-        """Build, run and read the suspension of ``settings``."""
-        from suspsim.rheology.suspension import batchelor
-        from suspsim.sph.simulation import Simulation
-
-        t0 = time.perf_counter()
-        scene = self._scene(settings)
-        sim = Simulation(scene, threads=threads)
-        t1 = time.perf_counter()
-        reading = couette_viscosity_ratio(sim, transient=1.0, units=int(settings["units"]))
-        reference = float(batchelor(sim.packing_phi))
-        return Run(Reading((1.0 + reading.value) / reference - 1.0, reading.stderr / reference),
-                   sim.n_particles, sim.step_count, sim.dt, sim.sound_speed,
-                   scene.number_density, scene.number_density ** (1.0 / 3.0), t1 - t0,
-                   time.perf_counter() - t1)
-
-
-def dilute_suspension(phi: float = 0.03) -> DiluteSuspensionCase:
-    """One sphere at ``phi`` (the Einstein test's 0.03: a = 2.5 h in a 12.5 h box)."""
-    axes = (Axis("radius", 2.5, "h", "sphere radius a in support radii (its resolution)"),
-            Axis("units", 4, "1", "strain units averaged after one of transient"),
-            Axis("wi_target", 1e-3, "1", "mu gdot/(rho c^2) of the sound speed"),
-            Axis("dt_coefficient", 0.05, "1", "C in the viscous step limit C rho h^2/mu_max"))
-    return DiluteSuspensionCase(f"suspension_dilute_phi{phi:g}",
-                                f"one sphere in a periodic box (3D), phi = {phi:g}",
-                                "Batchelor-Green 1 + 2.5 phi + 5.2 phi^2 (approximate: one "
-                                "sphere meets only its images)", axes, phi)
-
-
 #: Any kind of case: an SPH fluid case, a DST flow-curve point or channel, a dilute suspension.
 AnyCase = Case | DSTPointCase | DSTChannelCase | DiluteSuspensionCase
 
@@ -495,8 +278,8 @@ CASES: dict[str, AnyCase] = {case.name: case for case in (
     # the blind held-out set of docs/figures/error_model/run_holdout_blind_6.sh: never fitted on
     papanastasiou_couette(45.0, 2), bingham_poiseuille(2.5, 3), bingham_poiseuille(9.0, 3),
     newtonian_poiseuille(3, 0.5),
-    dst_flow_curve_point(0.54, 2.5),
-    dst_flow_curve_point(0.50, 1.0), dst_channel(0.54, 10.0), dilute_suspension(0.03))}
+    dst_flow_curve_point(0.54, 2.5), dst_flow_curve_point(0.50, 1.0), dst_channel(0.54, 10.0),
+    dilute_suspension(0.03))}
 
 
 def get_case(name: str) -> AnyCase:

@@ -136,7 +136,7 @@ def envelope_score(model: "ErrorModel", pairs: Sequence[tuple[Drivers, float]]) 
     """Mean log over-prediction [1] of the model inflated per class to bound every point of
     its class (:func:`inflation_class`): mean_i log(max_(j in class i)(y_j/m_j) / (y_i/m_i));
     smaller is a tighter upper envelope."""
-    ratios = np.array([bound / sum(model.terms(d).values()) for d, bound in pairs])
+    ratios = np.array([bound / model.model_error(d) for d, bound in pairs])
     classes = [inflation_class(d) for d, _ in pairs]
     top = class_maxima(ratios, classes)
     return float(np.mean(np.log(np.array([top[c] for c in classes]) / ratios)))
@@ -209,7 +209,7 @@ def fit_in_sample(points: Sequence[tuple[Drivers, float, float, str]],
     coef, exponents, _ = _fit_exponents([(d, b) for d, b, _ in finished], grid)
     first = ErrorModel(coef, exponents, 1.0, {}, {})
     def within(d, bound):
-        return math.isfinite(bound) and bound <= OUTLIER_RATIO * sum(first.terms(d).values())
+        return math.isfinite(bound) and bound <= OUTLIER_RATIO * first.model_error(d)
 
     def geometry(d):
         return (d.flow, d.dimension, round(d.resolution, 6), round(d.length, 6), d.units,
@@ -238,7 +238,7 @@ def fit_in_sample(points: Sequence[tuple[Drivers, float, float, str]],
     pairs = [(d, bound) for d, bound, _ in inliers]
     coef, exponents, score = _fit_exponents(pairs, grid)
     model = ErrorModel(coef, exponents, 1.0, {}, {})
-    ratios = np.array([bound / sum(model.terms(d).values()) for d, bound in pairs])
+    ratios = np.array([bound / model.model_error(d) for d, bound in pairs])
     model.inflation = float(max(1.0, ratios.max()))
     classes = np.array([inflation_class(d) for d, _ in pairs])
     model.class_inflation = {c: max(1.0, r) for c, r in sorted(
@@ -289,7 +289,7 @@ def held_out_ratios(points: Sequence[tuple[Drivers, float, float, str]],
                     or inflation_class(d) not in fold.class_inflation:
                 continue
             try:
-                model = sum(fold.terms(d).values())
+                model = fold.model_error(d)
             except InputError:
                 continue
             out.setdefault(inflation_class(d), []).append((bound / model, case))

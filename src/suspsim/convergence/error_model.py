@@ -282,9 +282,13 @@ class ErrorModel:
         """The inflation [1] applied to ``d``: its class's, else the global one."""
         return self.class_inflation.get(inflation_class(d), self.inflation)
 
+    def model_error(self, d: Drivers) -> float:
+        """Uninflated expected error bound [1]: the sum of :meth:`terms`."""
+        return sum(self.terms(d).values())
+
     def expected_error(self, d: Drivers) -> float:
         """Inflated expected error bound [1] (:mod:`.error_fit`)."""
-        return self.inflation_of(d) * sum(self.terms(d).values())
+        return self.inflation_of(d) * self.model_error(d)
 
     def expected_cost(self, d: Drivers) -> float:
         """Expected CPU time of one thread [s]."""

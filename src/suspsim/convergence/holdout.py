@@ -36,7 +36,7 @@ from suspsim.convergence.cases import Case, get_case
 from suspsim.convergence.error_model import ErrorModel, load_model
 from suspsim.convergence.measure import run_or_failure
 from suspsim.convergence.picker import evaluate, pick, verified_pick
-from suspsim.convergence.study import STDERR_FACTOR, case_dataset
+from suspsim.convergence.study import case_dataset, error_bound
 from suspsim.errors import InputError
 
 log = logging.getLogger(__name__)
@@ -84,11 +84,10 @@ def _measure(case: Case, settings: dict[str, Any]) -> dict[str, Any]:
 
 
 def _bound(record: dict[str, Any]) -> float:
-    """error + 2 standard errors of a record [1]; inf for a blow-up."""
+    """:func:`~.study.error_bound` of a record [1]; inf for a blow-up."""
     if "failure" in record:
         return math.inf
-    stderr = record["error_stderr"]
-    return record["error"] + STDERR_FACTOR * (stderr if math.isfinite(stderr) else 0.0)
+    return float(error_bound(record["error"], record["error_stderr"]))
 
 
 def check(case_name: str, tolerance: float, *, max_runs: int = MAX_COMPARISONS,

@@ -28,7 +28,7 @@ def run_configuration(case: AnyCase, overrides: Mapping[str, Any] | None = None,
     the L2/peak norm for profiles), ``error_stderr`` [1] (NaN where not estimated),
     ``wall_time`` and ``cpu_time`` [s] (set-up + run), ``setup_time`` [s], ``n_particles``,
     ``n_steps``, ``particle_steps_per_s`` [s-1], ``dt``, ``sound_speed``, ``number_density``
-    and ``resolution_used`` (:class:`~.cases.Run`). A run that leaves its health limits raises
+    and ``resolution_used`` (:class:`~.case_base.Run`). A run that leaves its health limits raises
     :class:`~suspsim.errors.NumericalError`.
     """
     settings = case.settings(overrides)

@@ -177,7 +177,7 @@ def verified_pick(case: Case, tolerance: float, run: Runner, model: ErrorModel |
     attempts when the calibrated model leaves no candidate or ``max_attempts`` runs missed."""
     _require_tolerance(tolerance)
     model = model or load_model()
-    rows = sorted(((s, d, sum(model.terms(d).values()), c)
+    rows = sorted(((s, d, model.model_error(d), c)
                    for s, d, _, c in evaluate(case, model)), key=lambda r: r[3])
     attempts: list[Attempt] = []
     tried: set[str] = set()

@@ -116,8 +116,8 @@ def case_dataset(case: AnyCase, records: Iterable[Mapping[str, Any]]) -> xr.Data
                        {"long_name": "health-check message of a configuration that blew up"})
     ds = xr.Dataset(data, coords={"configuration": ("configuration", np.array(ids, dtype=object),
                                                     {"long_name": "changed settings"})})
-    stderr = np.nan_to_num(ds["error_stderr"].values, nan=0.0)
-    ds["error_bound"] = ("configuration", ds["error"].values + STDERR_FACTOR * stderr,
+    ds["error_bound"] = ("configuration", error_bound(ds["error"].values,
+                                                      ds["error_stderr"].values),
                          {"units": "1", "long_name": f"error + {STDERR_FACTOR:g} standard errors"})
     ds["pareto"] = ("configuration", pareto_front(ds["cpu_time"].values,
                                                   ds["error_bound"].values).astype(np.int8),
@@ -125,6 +125,12 @@ def case_dataset(case: AnyCase, records: Iterable[Mapping[str, Any]]) -> xr.Data
     ds.attrs.update(case=case.name, description=case.description, reference=case.reference,
                     defaults=json.dumps(defaults), cost="cpu_time")
     return ds
+
+
+def error_bound(error, stderr):
+    """|error| + :data:`STDERR_FACTOR` standard errors [1] (a NaN standard error, where none is
+    estimated, counts as 0); scalars or arrays."""
+    return np.abs(error) + STDERR_FACTOR * np.nan_to_num(stderr, nan=0.0)
 
 
 def pareto_front(cost: np.ndarray, error: np.ndarray) -> np.ndarray:

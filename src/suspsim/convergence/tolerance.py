@@ -30,6 +30,7 @@ and the start jitter 0.1 (the model's training settings).
 """
 from __future__ import annotations
 
+import itertools
 import json
 import logging
 import math
@@ -41,10 +42,11 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import xarray as xr
 
-from suspsim.convergence.cases import Axis, Case, _channel_box, snapped_resolution
+from suspsim.convergence.case_base import Axis
+from suspsim.convergence.cases import Case, _channel_box, snapped_resolution
 from suspsim.convergence.error_model import FIXED, ErrorModel, load_model
 from suspsim.convergence.picker import Attempt, Choice, pick, verified_pick
-from suspsim.convergence.study import STDERR_FACTOR
+from suspsim.convergence.study import error_bound
 from suspsim.errors import InputError, NumericalError
 from suspsim.io.atomic import atomic_path
 from suspsim.io.netcdf import read_run
@@ -186,11 +188,10 @@ def measured_error(scene: Scene, result: xr.Dataset) -> float:
         means = [stress[unit == k].mean() / expected for k in range(units)
                  if np.any(unit == k)]
         if len(means) >= 2:
-            return (abs(float(np.mean(means)) - 1.0)
-                    + STDERR_FACTOR * float(np.std(means, ddof=1) / math.sqrt(len(means))))
-        stderr = float(result["viscosity_stderr"]) * rate / expected
-        return (abs(float(result["viscosity"]) * rate / expected - 1.0)
-                + STDERR_FACTOR * (stderr if math.isfinite(stderr) else 0.0))
+            return float(error_bound(np.mean(means) - 1.0,
+                                     np.std(means, ddof=1) / math.sqrt(len(means))))
+        return float(error_bound(float(result["viscosity"]) * rate / expected - 1.0,
+                                 float(result["viscosity_stderr"]) * rate / expected))
     y = result["y"].values
     reference = split_force_poiseuille_profile(
         scene.fluid.law, scene.density * scene.flow.body_force, scene.box[1], y)
@@ -221,25 +222,25 @@ def run_verified(scene: Scene, tolerance: float, out: str | PathLike, *, resume:
     model = model or load_model()
     case = scene_case(scene)
     out = Path(out)
-    runs: list[Path] = []
+    numbers = itertools.count(1)
 
     def attempt(settings):
         chosen, attrs = _set_up(scene, case, settings)
-        path = attempt_path(out, len(runs) + 1)
-        runs.append(path)
+        number = next(numbers)
+        path = attempt_path(out, number)
         c0 = time.process_time()
         if not (resume and path.exists()
                 and read_run(path).attrs.get("tolerance_settings") == attrs["tolerance_settings"]):
-            log.info("tolerance %g: attempt %d, %s", tolerance, len(runs),
+            log.info("tolerance %g: attempt %d, %s", tolerance, number,
                      attrs["tolerance_settings"])
             try:
                 run(chosen, path, resume=resume and checkpoint_path(path).exists(),
                     threads=threads, extra_attrs={"tolerance": float(tolerance), **attrs})
             except NumericalError as err:
-                log.warning("tolerance %g: attempt %d blew up: %s", tolerance, len(runs), err)
+                log.warning("tolerance %g: attempt %d blew up: %s", tolerance, number, err)
                 return math.inf, time.process_time() - c0, None
         measured = measured_error(chosen, read_run(path))
-        log.info("tolerance %g: attempt %d measured %.3g", tolerance, len(runs), measured)
+        log.info("tolerance %g: attempt %d measured %.3g", tolerance, number, measured)
         return measured, time.process_time() - c0, (chosen, path)
 
     attempts = verified_pick(case, tolerance, attempt, model)
