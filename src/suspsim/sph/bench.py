@@ -185,7 +185,8 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
         tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
         sim._v, sim._rho, sim._volume, sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2,
         sim._alpha, sim._beta,
-        sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of, sim._pressure,
+        sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of, sim._body_spin,
+        sim._pressure,
         sim._force_acc,
         sim._force_scratch, sim._bounds, sim._virial)
     calls["force finish"] = lambda: force_finish(

@@ -71,10 +71,10 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, smooth_rate, normalise,
                   normalisation_interval, normalisation_age, alpha, beta,
-                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
-                  pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
-                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
-                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
+                  bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, rho, volume,
+                  pressure, pair_start, pair_end, pair_j, geometry, pair_cross, pair_image,
+                  gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
+                  factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
                   force_scratch, bounds, virial, accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
 
@@ -88,11 +88,12 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     :func:`~suspsim.sph.terms.velocity_pass.normalisation_due` picks from
     ``normalisation_interval`` and ``normalisation_age`` and holds μ̂ in between;
     ``bulk_gradient`` the ∇a sums (B on and μ varying). ``has_bodies``: the scene has rigid
-    bodies, whose particles (``body_of`` (N,) ≥ 0; −1 for fluid) have no pairs inside their
-    own body in the list (``group`` of ``neighbours.build_neighbour_list``) and take their
-    density and μ̂ from the fluid around them (``density.body_particle_density``); their
-    gradient, rate and inverse moment are 0 and the normalisation keeps their μ̂
-    (``velocity_pass``).
+    bodies (angular velocities ``body_spin`` (B, 3), for ``terms.viscous.spin_free_velocity``;
+    a (1, 3) array of zeros without bodies), whose particles (``body_of`` (N,) ≥ 0; −1 for
+    fluid) have no pairs inside their own body in the list (``group`` of
+    ``neighbours.build_neighbour_list``) and take their density and μ̂ from the fluid around
+    them (``density.body_particle_density``); their gradient, rate and inverse moment are 0
+    and the normalisation keeps their μ̂ (``velocity_pass``).
     """
     shear_ly = shear_rate * box[1]
     code = summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours,
@@ -131,7 +132,7 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                 viscosity_hat[i] = viscosity[i]
     force_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
                volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
-               shear_ly, body_of, pressure, force_acc, force_scratch, bounds, virial)
+               shear_ly, body_of, body_spin, pressure, force_acc, force_scratch, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
     return TABLE_OK
@@ -143,10 +144,10 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta,
-                  bulk_factor, bulk_gradient, has_bodies, body_of, rho, volume, pressure,
-                  pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, gradient,
-                  inverse_moment, moment_trace, strain, dissipation, gdot, viscosity, factor,
-                  viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
+                  bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, rho, volume,
+                  pressure, pair_start, pair_end, pair_j, geometry, pair_cross, pair_image,
+                  gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
+                  factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
                   force_scratch, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, stop).
 
@@ -170,10 +171,10 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
             mass, rho_eq, c2, shear_rate, body_force, dimension, law_code, law_params, newtonian,
             velocity_gradient, smooth_rate, normalise, normalisation_interval, normalisation_age,
             alpha, beta, bulk_factor, bulk_gradient,
-            has_bodies, body_of, rho, volume, pressure, pair_start, pair_end, pair_j, geometry,
-            pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation,
-            gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
-            scratch_15, force_scratch, bounds, virial, accel_new)
+            has_bodies, body_of, body_spin, rho, volume, pressure, pair_start, pair_end, pair_j,
+            geometry, pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain,
+            dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc,
+            scratch_1, scratch_15, force_scratch, bounds, virial, accel_new)
         if code != TABLE_OK:
             return done, GROW_TABLE
         kick(velocities, accel, accel_new, dt)

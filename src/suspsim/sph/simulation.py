@@ -238,6 +238,9 @@ class Simulation:
         self._virial = np.zeros((t, 5))
         self._body_of = np.full(n, -1, dtype=np.int64)
         self._offsets = np.zeros((n if self.bodies is not None else 0, 3))
+        # The bodies' angular velocities at the force pass's time level (``_place_bodies``).
+        self._body_spin = (self.bodies.angular_velocities() if self.bodies is not None
+                           else np.zeros((1, 3)))
         self._members = np.zeros(0, dtype=np.int64)
         self._body_virial = np.zeros(5)
         self._lubrication_virial = np.zeros(5)
@@ -329,8 +332,7 @@ class Simulation:
                 self._velocity_gradient, self._smooth_rate, self._normalise,
                 self.scene.numerics.normalisation_interval, self._normalisation_age, self._alpha,
                 self._beta, self._bulk_factor, self._bulk_gradient, self.bodies is not None,
-                self._body_of,
-                self._rho, self._volume,
+                self._body_of, self._body_spin, self._rho, self._volume,
                 self._pressure, tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry,
                 tb.pair_cross, tb.pair_image, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
@@ -395,7 +397,9 @@ class Simulation:
 
     def _place_bodies(self, rotations, velocities, omegas, time: float, out) -> None:
         """Body particles at their rigid positions (``rotations`` (B, 3, 3) of the bodies'
-        current orientations); their velocities into ``out``."""
+        current orientations); their velocities into ``out``, and ``omegas`` into the force
+        pass's body spins."""
+        self._body_spin[:] = omegas
         place_body_particles(self._members, self._body_of, self._offsets, self.bodies.centres,
                              rotations, velocities, omegas, self._box, self._offset(time),
                              self._rate, self._x, out)

@@ -42,20 +42,26 @@ def test_pair_force_is_antisymmetric_and_vanishes_beyond_the_support(bulk):
     assert np.all(beyond == 0.0)
 
 
-def _two_particle_force(body_of, viscosity):
-    """Force on particle 0 from particle 1 through ``force_sums`` (c = 0: viscous only)."""
-    d = np.array([0.3, 0.2, -0.1])
+PAIR_SEPARATION = np.array([0.3, 0.2, -0.1])
+
+
+def _two_particle_force(body_of, viscosity, velocity=((0.1, -0.2, 0.05), (0.0, 0.3, 0.0)),
+                        spin=((0.0, 0.0, 0.0),), both_ends=False):
+    """Force on particle 0 from particle 1 (r_01 = PAIR_SEPARATION) through ``force_sums``
+    (c = 0: viscous only), the bodies' angular velocities ``spin`` (B, 3); with ``both_ends``
+    the forces on both particles."""
+    d = PAIR_SEPARATION
     f = kernel_f(LUCY_3D, float(np.linalg.norm(d)), 1.0)
-    velocity = np.array([[0.1, -0.2, 0.05], [0.0, 0.3, 0.0]])
+    velocity = np.asarray(velocity, dtype=float)
     width = force_width(False, False)
     acc = np.zeros(2 * width)
     alpha, beta = viscous_weights(3, True)
     force_sums(np.array([0, 1, 1]), np.array([1, 1]), np.array([1]), np.array([[*d, f]]),
                np.array([1, 1]), np.zeros(1, dtype=np.int64), velocity, np.full(2, 4.0),
                np.full(2, 0.25), np.asarray(viscosity, dtype=float), 1.0, 4.0, 0.0, alpha,
-               beta, -5.0 / 3.0, False, 0.0, np.asarray(body_of), np.zeros(2), acc,
-               np.zeros((0, 2 * width)), np.array([0, 2]), np.zeros((1, 5)))
-    return acc[:3]
+               beta, -5.0 / 3.0, False, 0.0, np.asarray(body_of), np.asarray(spin, dtype=float),
+               np.zeros(2), acc, np.zeros((0, 2 * width)), np.array([0, 2]), np.zeros((1, 5)))
+    return acc.reshape(2, width)[:, :3] if both_ends else acc[:3]
 
 
 def test_a_fluid_body_pair_takes_the_fluid_viscosity_at_both_ends():
@@ -65,6 +71,28 @@ def test_a_fluid_body_pair_takes_the_fluid_viscosity_at_both_ends():
     np.testing.assert_allclose(_two_particle_force([-1, 0], [1.5, 9.0]), fluid_pair, rtol=1e-14)
     np.testing.assert_allclose(_two_particle_force([0, -1], [9.0, 1.5]), fluid_pair, rtol=1e-14)
     assert not np.allclose(_two_particle_force([-1, -1], [1.5, 9.0]), fluid_pair)
+
+
+def test_a_fluid_particle_rotating_rigidly_with_a_body_feels_no_viscous_force():
+    """``viscous.spin_free_velocity``: v_01 = Ω × r_01 is the body's rigid rotation, which the
+    β term of the pair form would resist (the spurious torque that spun a sphere at 1.36 × γ̇/2);
+    relative to the body's spin it vanishes, for a body at either end and for two bodies of
+    the same spin. A different spin leaves the part of v_01 it does not explain, and the pair
+    stays antisymmetric (momentum conserved)."""
+    omega = np.array([0.3, -0.7, 1.1])
+    body_velocity = np.array([0.2, 0.1, -0.4])
+    rigid = [body_velocity + np.cross(omega, PAIR_SEPARATION), body_velocity]
+    assert np.linalg.norm(_two_particle_force([-1, -1], [1.0, 1.0], rigid)) > 1e-3
+    for body_of in ([-1, 0], [0, -1]):
+        np.testing.assert_allclose(_two_particle_force(body_of, [1.0, 1.0], rigid, [omega]), 0.0,
+                                   atol=1e-15)
+    np.testing.assert_allclose(
+        _two_particle_force([0, 1], [1.0, 1.0], rigid, [omega, omega]), 0.0, atol=1e-15)
+    half_spin = _two_particle_force([-1, 0], [1.0, 1.0], rigid, [0.5 * omega], both_ends=True)
+    relative = [body_velocity + np.cross(0.5 * omega, PAIR_SEPARATION), body_velocity]
+    np.testing.assert_allclose(half_spin[0], _two_particle_force([-1, -1], [1.0, 1.0], relative),
+                               rtol=1e-12)
+    np.testing.assert_allclose(half_spin[0], -half_spin[1], rtol=1e-14)
 
 
 def test_viscous_weights_combine_a_and_b_as_derived():

@@ -16,7 +16,9 @@ of particles of two bodies takes at each end the μ̂ of the fluid beside that p
 (``body_of[i] == body_of[j] ≥ 0``) have no force: they are internal to the body, and the β
 term of a rotating body would give a spurious torque. The simulation's list does not hold
 them (``group`` of ``neighbours.build_neighbour_list``); the loop also skips them, for tables
-built without groups. With the
+built without groups. For the same reason a pair with a body particle takes v relative to the
+body's rigid rotation, v − Ω_B × r (``viscous.spin_free_velocity``; Ω_B from ``body_spin``).
+With the
 bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
 ∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
 explicit term ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k is added per particle afterwards; it has no pair
@@ -50,7 +52,8 @@ from numba import njit, prange
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.terms.pressure import pressure_pair, pressure_term
-from suspsim.sph.terms.viscous import explicit_bulk_term, pair_viscosity, viscous_pair
+from suspsim.sph.terms.viscous import (explicit_bulk_term, pair_viscosity, spin_free_velocity,
+                                      viscous_pair)
 
 
 def force_width(bulk_gradient: bool, shifting: bool) -> int:
@@ -66,7 +69,7 @@ VXX, VYY, VZZ, VXY, VYX = range(5)
 @njit(inline="always", **JIT_OPTIONS)
 def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity,
                 volume, pressure, viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
-                body_of, acc, virial_row):
+                body_of, body_spin, acc, virial_row):
     """acc[w i ...] += forces, ∇a sums and ∇C (layout of :func:`force_width`) of particles
     lo..hi−1, both ends; virial_row +=."""
     n = volume.shape[0]
@@ -102,11 +105,14 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
             vol_j = volume[j]
             kp = pressure_pair(p_i, pressure[j], f)
             mu_a, mu_b = mu_i, viscosity[j]
-            if (body_i >= 0) != (body_of[j] >= 0):
-                if body_i >= 0:
-                    mu_a = mu_b
-                else:
+            body_j = body_of[j]
+            if body_i >= 0 or body_j >= 0:
+                vx, vy, vz = spin_free_velocity(body_spin, body_i, body_j, dx, dy, dz,
+                                                vx, vy, vz)
+                if body_i < 0:
                     mu_b = mu_a
+                elif body_j < 0:
+                    mu_a = mu_b
             wx, wy, wz = viscous_pair(pair_viscosity(mu_a, mu_b), f * vol_i * vol_j,
                                       dx, dy, dz, r2, vx, vy, vz, alpha, beta)
             fx = kp * dx + wx
@@ -163,11 +169,13 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
 @njit(parallel=True, **JIT_OPTIONS)
 def force_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity, rho, volume,
                viscosity, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
-               body_of, pressure, acc, scratch, bounds, virial):
+               body_of, body_spin, pressure, acc, scratch, bounds, virial):
     """acc (w N,) = pair forces, ∇a sums and ∇C of every particle, w = :func:`force_width`
     (columns beyond the force and, with ``bulk_gradient``, the ∇a sums take ∇C); ``scratch``
     rows of w N; virial (T, 5) per chunk; ``pressure`` (N,) scratch for the particles'
-    m² P/ρ²; ``body_of`` (N,) the rigid body of each particle, −1 for fluid."""
+    m² P/ρ²; ``body_of`` (N,) the rigid body of each particle, −1 for fluid; ``body_spin``
+    (B, 3) the bodies' angular velocities [τ⁻¹] (:func:`spin_free_velocity`; any (≥ 1, 3)
+    array without bodies)."""
     for i in prange(rho.shape[0]):
         pressure[i] = pressure_term(rho[i], rho_eq, c2, mass)
     n_chunks = scratch.shape[0] + 1
@@ -181,13 +189,14 @@ def force_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, veloci
             acc[:] = 0.0
             _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image,
                         velocity, volume, pressure, viscosity, alpha, beta, bulk_factor,
-                        bulk_gradient, shear_ly, body_of, acc, virial[0])
+                        bulk_gradient, shear_ly, body_of, body_spin, acc, virial[0])
         else:
             buffer = scratch[c - 1]
             buffer[width * lo:] = 0.0
             _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image,
                         velocity, volume, pressure, viscosity, alpha, beta, bulk_factor,
-                        bulk_gradient, shear_ly, body_of, buffer, virial[c])
+                        bulk_gradient, shear_ly, body_of, body_spin, buffer,
+                        virial[c])
     add_chunk_buffers(acc, scratch, bounds, n_chunks, width)
 
 

@@ -71,6 +71,36 @@ def viscous_pair(mu_sum, scale, dx, dy, dz, r2, vx, vy, vz, alpha, beta):
 
 
 @njit(inline="always", **JIT_OPTIONS)
+def spin_free_velocity(body_spin, body_i, body_j, dx, dy, dz, vx, vy, vz):
+    """v_ij − w × r_ij for a pair with a rigid-body particle [h τ⁻¹]: w = Ω_B, the angular
+    velocity [τ⁻¹] of the one body of a fluid–body pair (``body_spin[B]``), or the mean of the
+    two bodies' for a pair of particles of two bodies; ``body_i``, ``body_j`` the pair's body
+    indices (−1 for fluid), r_ij = (dx, dy, dz), v_ij = (vx, vy, vz).
+
+    Why [derived; a correction to seed 000's pair form for rigid inclusions]: the β v term of
+    :func:`viscous_pair` is not invariant under rigid rotation (r·(Ω × r) = 0 but Ω × r ≠ 0),
+    so its continuum stress is μ[(1 − β′)(∇v + ∇vᵀ) + β′ ∇v]-like rather than 2μE: the two
+    differ by μ ∇vᵀ, which is divergence-free in an incompressible fluid of uniform μ (the
+    bulk forces are right) but whose moment over a body's surface, ∫ x ⊗ (∇vᵀ · n) dS =
+    V_B ∇v_B, is the body's own rotation. A fluid co-rotating with the body would then exert a
+    torque on it, and a torque-free sphere in simple shear spun at 1.36 × γ̇/2 instead of γ̇/2
+    (one sphere, a = 2.4 h, φ = 0.03, README). Taking v relative to the body's rigid rotation
+    removes that moment from the fluid–body pairs: a fluid particle moving rigidly with the body
+    feels no viscous force from it (the sphere then turned at 1.26 × γ̇/2; the fluid–fluid pairs
+    of the one-sided neighbourhood beside the body carry the same term, README). The α term is
+    unchanged (r·(w × r) = 0); the pair force stays antisymmetric, so momentum is conserved.
+    """
+    if body_i >= 0 and body_j >= 0:
+        wx = 0.5 * (body_spin[body_i, 0] + body_spin[body_j, 0])
+        wy = 0.5 * (body_spin[body_i, 1] + body_spin[body_j, 1])
+        wz = 0.5 * (body_spin[body_i, 2] + body_spin[body_j, 2])
+    else:
+        b = body_i if body_i >= 0 else body_j
+        wx, wy, wz = body_spin[b, 0], body_spin[b, 1], body_spin[b, 2]
+    return (vx - (wy * dz - wz * dy), vy - (wz * dx - wx * dz), vz - (wx * dy - wy * dx))
+
+
+@njit(inline="always", **JIT_OPTIONS)
 def explicit_bulk_term(gax, gay, gaz, g, rho):
     """Acceleration ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k, divided by ρ [SPEC §2.3, derived].
 
