@@ -1,11 +1,11 @@
 """Spin of torque-free spheres in simple shear against γ̇/2.
 
-    python docs/figures/make_sphere_spin.py [--phi 0.03] [--box 12.5] [--seeds 1]
-        [--strain 1 2] [--set KEY=VALUE ...]
+    python docs/figures/make_sphere_spin.py [--phi 0.03] [--box 12.5] [--radius 2.5]
+        [--seeds 1] [--strain 1 2] [--set KEY=VALUE ...]
 
 A torque-free sphere in Stokes shear flow u = γ̇ y e_x turns with the fluid's rotation,
-Ω = −γ̇/2 e_z; in a dilute periodic array its images change that by O(φ). Spheres of a = 2.5 h
-(volume-equivalent; the packer scales them to the exact φ) in the Newtonian matrix of
+Ω = −γ̇/2 e_z; in a dilute periodic array its images change that by O(φ). Spheres of radius a
+(``--radius``, default 2.5 h; the packer scales them to the exact φ) in the Newtonian matrix of
 :mod:`suspsim.validation.suspension`, sampled 50 times per strain unit after the transient:
 prints the mean Ω/(γ̇/2) over bodies and samples (x, y, z components) and the range of the
 bodies' own mean Ω_z/(γ̇/2). One thread per run; writes nothing.
@@ -26,6 +26,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--phi", type=float, default=0.03)
     parser.add_argument("--box", type=float, default=12.5, help="cube side [h]")
+    parser.add_argument("--radius", type=float, default=RADIUS, help="sphere radius a [h]")
     parser.add_argument("--seeds", type=int, nargs="+", default=[1])
     parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 2.0],
                         metavar=("TRANSIENT", "UNITS"))
@@ -35,12 +36,12 @@ def main() -> None:
     transient, units = args.strain
     overrides = parse_overrides(args.set)
     settings = "".join(f", {key} = {value}" for key, value in overrides.items())
-    print(f"φ = {args.phi}, box {args.box} h, a = {RADIUS} h, γ̇ = {RATE}, strain {transient:g} + "
-          f"{units:g}{settings}\n| seed | bodies | mean Ω/(γ̇/2) (x, y, z) | bodies' Ω_z/(γ̇/2) | "
-          f"CPU [s] |\n|---|---|---|---|---|", flush=True)
+    print(f"φ = {args.phi}, box {args.box} h, a = {args.radius} h, γ̇ = {RATE}, strain "
+          f"{transient:g} + {units:g}{settings}\n| seed | bodies | mean Ω/(γ̇/2) (x, y, z) | "
+          f"bodies' Ω_z/(γ̇/2) | CPU [s] |\n|---|---|---|---|---|", flush=True)
     for seed in args.seeds:
         started = time.process_time()
-        scene = suspension_scene(phi=args.phi, radius=RADIUS, box=args.box, seed=seed,
+        scene = suspension_scene(phi=args.phi, radius=args.radius, box=args.box, seed=seed,
                                  strain=transient + units, overrides=overrides)
         sim = Simulation(scene, threads=1)
         per_unit = int(round(1.0 / (RATE * sim.dt)))
