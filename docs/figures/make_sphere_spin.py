@@ -15,11 +15,10 @@ import time
 
 import numpy as np
 
-from suspsim.sph.simulation import Simulation
-from suspsim.validation.suspension import RATE, parse_overrides, suspension_scene
+from suspsim.validation.suspension import (RATE, parse_overrides, sampled_run,
+                                           suspension_scene)
 
 RADIUS = 2.5
-SAMPLES_PER_UNIT = 50
 
 
 def main() -> None:
@@ -43,14 +42,8 @@ def main() -> None:
         started = time.process_time()
         scene = suspension_scene(phi=args.phi, radius=args.radius, box=args.box, seed=seed,
                                  strain=transient + units, overrides=overrides)
-        sim = Simulation(scene, threads=1)
-        per_unit = int(round(1.0 / (RATE * sim.dt)))
-        sim.advance(int(round(transient * per_unit)))
-        spins = []
-        for _ in range(int(round(units * SAMPLES_PER_UNIT))):
-            sim.advance(per_unit // SAMPLES_PER_UNIT)
-            spins.append(sim.bodies.angular_velocities() / (0.5 * RATE))
-        spins = np.array(spins)
+        spins = np.array([sim.bodies.angular_velocities() / (0.5 * RATE)
+                          for sim in sampled_run(scene, transient=transient, units=units)])
         mean = spins.mean(axis=(0, 1))
         own = spins[:, :, 2].mean(axis=0)
         print(f"| {seed} | {spins.shape[1]} | {mean[0]:+.3f}, {mean[1]:+.3f}, {mean[2]:+.3f} | "

@@ -17,12 +17,11 @@ import argparse
 import numpy as np
 from numba import njit
 
-from suspsim.sph.simulation import Simulation
 from suspsim.sph.terms.force_pass import VXY
-from suspsim.validation.suspension import RATE, parse_overrides, suspension_scene
+from suspsim.validation.suspension import (RATE, parse_overrides, sampled_run,
+                                           suspension_scene)
 
 RADIUS = 2.5
-SAMPLES_PER_UNIT = 50
 
 
 @njit(cache=True)
@@ -58,12 +57,8 @@ def main() -> None:
     overrides = parse_overrides(args.set)
     scene = suspension_scene(phi=args.phi, radius=RADIUS, box=args.box, seed=args.seed,
                              strain=transient + units, overrides=overrides)
-    sim = Simulation(scene, threads=1)
-    per_unit = int(round(1.0 / (RATE * sim.dt)))
-    sim.advance(int(round(transient * per_unit)))
     rows = []
-    for _ in range(int(round(units * SAMPLES_PER_UNIT))):
-        sim.advance(per_unit // SAMPLES_PER_UNIT)
+    for sim in sampled_run(scene, transient=transient, units=units):
         table = sim._table
         fluid, mixed = pressure_virials(table.pair_start, table.pair_end, table.pair_j,
                                         table.pair_geometry, sim._pressure, sim._body_of)

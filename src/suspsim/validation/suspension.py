@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import math
 import time
-from typing import Any, Mapping, NamedTuple, Sequence
+from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from suspsim.errors import NumericalError
 from suspsim.scene import Scene, scene_from_dict
 from suspsim.sph.lattice import imposed_velocity
 from suspsim.sph.simulation import Simulation
-from suspsim.validation.flows import couette_viscosity_ratio
+from suspsim.validation.flows import SAMPLES_PER_UNIT, couette_viscosity_ratio
 
 RATE = 0.004
 """Imposed shear rate [τ⁻¹]."""
@@ -115,3 +115,16 @@ def relative_viscosity(*, shape: str = "sphere", phi: float, radius: float, box:
     return SuspensionReading(1.0 + reading.value, reading.stderr,
                              time.process_time() - started, sim.n_particles, sim.packing_phi,
                              watch.density_error, watch.smallest_gap, watch.body_speed)
+
+
+def sampled_run(scene: Scene, *, transient: float, units: float) -> Iterator[Simulation]:
+    """A one-thread :class:`Simulation` of the Couette ``scene`` run ``transient`` strain units,
+    then yielded after each of ``SAMPLES_PER_UNIT`` equal strides per strain unit for ``units``
+    units, for the figure scripts that read more than σ_xy (``make_sphere_spin.py``,
+    ``make_stress_split.py``)."""
+    sim = Simulation(scene, threads=1)
+    per_unit = int(round(1.0 / (scene.flow.shear_rate * sim.dt)))
+    sim.advance(int(round(transient * per_unit)))
+    for _ in range(int(round(units * SAMPLES_PER_UNIT))):
+        sim.advance(max(1, per_unit // SAMPLES_PER_UNIT))
+        yield sim
