@@ -22,7 +22,11 @@ Time step [SPEC §2.6; coefficients measured by ``tests/unit/sph/test_simulation
 
     δt = min( C_ν ρ h²/μ_max, C_c h/(c + v_s), C_a sqrt(h/g) ),
 
-C_ν = ``numerics.dt_viscous_coefficient`` (0.05; the probe found 0.09 stable), C_c =
+C_ν = ``numerics.dt_viscous_coefficient`` (0.05; the probe found 0.09 stable) divided by the
+viscous stiffness κ = (α + β)/(α + β)_B of the pair form's weights (``terms.viscous``): the
+coefficient was measured with the bulk correction B, (α + β)_B = 5/3 in 3D and 1 in 2D; without
+it the pair force along r is α = d + 2, three (3D) or four (2D) times stiffer, and a run at the
+step of the corrected form blew up within 100 steps. C_c =
 :data:`ACOUSTIC_COEFFICIENT`, C_a = :data:`FORCE_COEFFICIENT`, h the support radius. μ_max is
 the largest viscosity the run can meet [choice]: μ(0) where γ̇ can vanish (a start from rest,
 the Poiseuille centre line), μ(γ̇/2) in Couette from the linear profile (local rates stay near
@@ -39,6 +43,7 @@ import math
 from suspsim.reference.poiseuille import poiseuille_profile
 from suspsim.rheology.laws import make_law
 from suspsim.scene import Scene
+from suspsim.sph.terms.viscous import viscous_weights
 
 #: Target Mach number of the velocity scale (Morris et al. 1997) [choice].
 MACH_TARGET = 0.1
@@ -112,11 +117,18 @@ def max_viscosity(scene: Scene) -> float:
     return float(law.viscosity(0.0))
 
 
+def viscous_stiffness(scene: Scene) -> float:
+    """κ = (α + β)/(α + β)_B [1]: the largest pair weight of the scene's viscous form against
+    the bulk-corrected form's, for which C_ν was measured (module docstring)."""
+    return (sum(viscous_weights(scene.dimension, scene.numerics.bulk_correction))
+            / sum(viscous_weights(scene.dimension, True)))
+
+
 def stable_time_step(scene: Scene, sound_speed: float, *,
                      acoustic_coefficient: float = ACOUSTIC_COEFFICIENT) -> float:
     """δt = min(C_ν ρ h²/μ_max, C_c h/(c + v_s), C_a sqrt(h/g)) (module docstring)."""
     limits = [scene.numerics.dt_viscous_coefficient * scene.density * SUPPORT ** 2
-              / max_viscosity(scene),
+              / (max_viscosity(scene) * viscous_stiffness(scene)),
               acoustic_coefficient * SUPPORT / (sound_speed + velocity_scale(scene))]
     if scene.flow.body_force > 0:
         limits.append(FORCE_COEFFICIENT * math.sqrt(SUPPORT / scene.flow.body_force))
