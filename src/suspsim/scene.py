@@ -113,6 +113,7 @@ class NumericsSpec:
     rate_smoothing: bool
     pressure_reference: str
     dt_viscous_coefficient: float
+    spin_correction: bool
 
 
 @dataclass(frozen=True)

@@ -171,8 +171,9 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
             sim._bounds)
         calls["gradient finish"] = lambda: _gradient_finish(
             sim._grad_acc, sim.scene.dimension, law.code, law.packed, sim._newtonian,
-            sim._normalise, sim._beta, sim._body_of, sim._gradient, sim._inverse_moment,
-            sim._moment_trace, sim._gdot, sim._mu, sim._strain, sim._dissipation)
+            sim._normalise, sim._beta, sim._spin_correction, sim._body_of, sim._gradient,
+            sim._inverse_moment, sim._moment_trace, sim._gdot, sim._mu, sim._strain,
+            sim._dissipation)
     if sim._normalise:
         if sim._alpha != 0.0:
             calls["dissipation sums"] = lambda: _dissipation_sums(
@@ -180,14 +181,13 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
                 sim._diss_acc, sim._scratch_1, sim._bounds)
         calls["normalisation finish"] = lambda: _normalisation_finish(
             sim._diss_acc, sim._dissipation, sim._gradient, sim._moment_trace, sim._mu,
-            sim._alpha, sim._beta, sim.scene.dimension, sim._body_of, sim._factor, sim._mu_hat)
+            sim._alpha, sim._beta, sim._spin_correction, sim.scene.dimension, sim._body_of,
+            sim._factor, sim._mu_hat)
     calls["force sums"] = lambda: force_sums(
         tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, tb.pair_cross, tb.pair_image,
         sim._v, sim._rho, sim._volume, sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2,
-        sim._alpha, sim._beta,
-        sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of, sim._body_spin,
-        sim._pressure,
-        sim._force_acc,
+        sim._alpha, sim._beta, sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of,
+        sim._body_spin, sim._spin_correction, sim._gradient, sim._pressure, sim._force_acc,
         sim._force_scratch, sim._bounds, sim._virial)
     calls["force finish"] = lambda: force_finish(
         sim._force_acc, sim._x, sim._rho, sim._inverse_moment, sim._gradient, sim._mass,

@@ -71,11 +71,11 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   kernel, h, mass, rho_eq, c2, shear_rate, body_force, dimension, law_code,
                   law_params, newtonian, velocity_gradient, smooth_rate, normalise,
                   normalisation_interval, normalisation_age, alpha, beta,
-                  bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, rho, volume,
-                  pressure, pair_start, pair_end, pair_j, geometry, pair_cross, pair_image,
-                  gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
-                  factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
-                  force_scratch, bounds, virial, accel_out):
+                  bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, spin_correction,
+                  rho, volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
+                  pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
+                  viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
+                  scratch_15, force_scratch, bounds, virial, accel_out):
     """a = f(x, ṽ)/m through the four passes; fills ρ, γ̇, μ, s, μ̂, the virial and ``accel_out``.
 
     Returns ``density.TABLE_OK``, or ``density.TABLE_OVERFLOW`` straight after the density pass
@@ -93,7 +93,10 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     fluid) have no pairs inside their own body in the list (``group`` of
     ``neighbours.build_neighbour_list``) and take their density and μ̂ from the fluid around
     them (``density.body_particle_density``); their gradient, rate and inverse moment are 0
-    and the normalisation keeps their μ̂ (``velocity_pass``).
+    and the normalisation keeps their μ̂ (``velocity_pass``). ``spin_correction``
+    (``numerics.spin_correction``, which needs ``velocity_gradient``) takes the β term of
+    fluid–fluid pairs relative to the particles' local spin (``terms.viscous.local_spin``) and
+    normalises by the strain rate alone.
     """
     shear_ly = shear_rate * box[1]
     code = summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours,
@@ -113,8 +116,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
         _gradient_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted,
                        volume, shear_ly, dimension, grad_acc, scratch_15, bounds)
         _gradient_finish(grad_acc, dimension, law_code, law_params, newtonian or smooth_rate,
-                         normalise, beta, body_of, gradient, inverse_moment, moment_trace, gdot,
-                         viscosity, strain, dissipation)
+                         normalise, beta, spin_correction, body_of, gradient, inverse_moment,
+                         moment_trace, gdot, viscosity, strain, dissipation)
         if smooth_rate and not newtonian:
             smoothed_rate_viscosity(pair_start, pair_end, pair_j, geometry, kernel, h, volume,
                                     gradient, body_of, law_code, law_params,
@@ -125,14 +128,15 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
             _dissipation_sums(pair_start, pair_end, pair_j, geometry, volume, strain, diss_acc,
                               scratch_1, bounds)
         _normalisation_finish(diss_acc, dissipation, gradient, moment_trace, viscosity, alpha,
-                              beta, dimension, body_of, factor, viscosity_hat)
+                              beta, spin_correction, dimension, body_of, factor, viscosity_hat)
     elif not newtonian:
         for i in range(viscosity.shape[0]):
             if body_of[i] < 0:
                 viscosity_hat[i] = viscosity[i]
     force_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
                volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
-               shear_ly, body_of, body_spin, pressure, force_acc, force_scratch, bounds, virial)
+               shear_ly, body_of, body_spin, spin_correction, gradient, pressure, force_acc,
+               force_scratch, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
     return TABLE_OK
@@ -144,11 +148,11 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta,
-                  bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, rho, volume,
-                  pressure, pair_start, pair_end, pair_j, geometry, pair_cross, pair_image,
-                  gradient, inverse_moment, moment_trace, strain, dissipation, gdot, viscosity,
-                  factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1, scratch_15,
-                  force_scratch, bounds, virial):
+                  bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, spin_correction,
+                  rho, volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
+                  pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
+                  viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
+                  scratch_15, force_scratch, bounds, virial):
     """Run up to ``n_steps`` steps from ``step_count``; returns (steps completed, stop).
 
     stop is :data:`DONE`, or :data:`REBUILD` or :data:`GROW_TABLE`: the drift of step
@@ -171,7 +175,8 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
             mass, rho_eq, c2, shear_rate, body_force, dimension, law_code, law_params, newtonian,
             velocity_gradient, smooth_rate, normalise, normalisation_interval, normalisation_age,
             alpha, beta, bulk_factor, bulk_gradient,
-            has_bodies, body_of, body_spin, rho, volume, pressure, pair_start, pair_end, pair_j,
+            has_bodies, body_of, body_spin, spin_correction, rho, volume, pressure, pair_start,
+            pair_end, pair_j,
             geometry, pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain,
             dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc,
             scratch_1, scratch_15, force_scratch, bounds, virial, accel_new)

@@ -107,8 +107,10 @@ class Simulation:
         self._newtonian = bool(law.is_newtonian)
         self._normalise = bool(scene.numerics.viscous_normalisation)
         self._bulk_gradient = bool(scene.numerics.bulk_correction) and not self._newtonian
-        self._velocity_gradient = (not self._newtonian) or self._normalise
-        self._alpha, self._beta = viscous_weights(scene.dimension, scene.numerics.bulk_correction)
+        self._spin_correction = bool(scene.numerics.spin_correction)
+        self._velocity_gradient = (not self._newtonian) or self._normalise or self._spin_correction
+        self._alpha, self._beta = viscous_weights(scene.dimension, scene.numerics.bulk_correction,
+                                                  self._spin_correction)
         self._bulk_factor = bulk_factor(scene.dimension)
         self._box = np.array([*scene.box, *([1.0] if scene.dimension == 2 else [])], dtype=float)
         self._kernel = kernels.kernel_code(scene.kernel, scene.dimension)
@@ -332,7 +334,7 @@ class Simulation:
                 self._velocity_gradient, self._smooth_rate, self._normalise,
                 self.scene.numerics.normalisation_interval, self._normalisation_age, self._alpha,
                 self._beta, self._bulk_factor, self._bulk_gradient, self.bodies is not None,
-                self._body_of, self._body_spin, self._rho, self._volume,
+                self._body_of, self._body_spin, self._spin_correction, self._rho, self._volume,
                 self._pressure, tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry,
                 tb.pair_cross, tb.pair_image, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
@@ -525,7 +527,7 @@ class Simulation:
                  self._mu.copy(), self._mu_hat.copy())
         self._law = make_law("newtonian", {"mu": mu})
         self._newtonian, self._bulk_gradient = True, False
-        self._velocity_gradient = self._normalise
+        self._velocity_gradient = self._normalise or self._spin_correction
         self._mu[:] = mu
         self._mu_hat[:] = mu
         try:

@@ -26,7 +26,8 @@ C_ν = ``numerics.dt_viscous_coefficient`` (0.05; the probe found 0.09 stable) d
 viscous stiffness κ = (α + β)/(α + β)_B of the pair form's weights (``terms.viscous``): the
 coefficient was measured with the bulk correction B, (α + β)_B = 5/3 in 3D and 1 in 2D; without
 it the pair force along r is α = d + 2, three (3D) or four (2D) times stiffer, and a run at the
-step of the corrected form blew up within 100 steps. C_c =
+step of the corrected form blew up within 100 steps; ``numerics.spin_correction`` doubles β
+(κ = 3/2 in 3D, 2 in 2D). C_c =
 :data:`ACOUSTIC_COEFFICIENT`, C_a = :data:`FORCE_COEFFICIENT`, h the support radius. μ_max is
 the largest viscosity the run can meet [choice]: μ(0) where γ̇ can vanish (a start from rest,
 the Poiseuille centre line), μ(γ̇/2) in Couette from the linear profile (local rates stay near
@@ -120,7 +121,8 @@ def max_viscosity(scene: Scene) -> float:
 def viscous_stiffness(scene: Scene) -> float:
     """κ = (α + β)/(α + β)_B [1]: the largest pair weight of the scene's viscous form against
     the bulk-corrected form's, for which C_ν was measured (module docstring)."""
-    return (sum(viscous_weights(scene.dimension, scene.numerics.bulk_correction))
+    return (sum(viscous_weights(scene.dimension, scene.numerics.bulk_correction,
+                                scene.numerics.spin_correction))
             / sum(viscous_weights(scene.dimension, True)))
 
 

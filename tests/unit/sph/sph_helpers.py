@@ -7,9 +7,11 @@ from suspsim.validation.flows import couette_viscosity_ratio
 
 
 def couette_scene(dim=3, side=5.0, number_density=4.096, law="newtonian", params=None,
-                  rate=0.05, jitter=0.0, normalise=True, bulk=True, seed=1, interval=None, **run):
+                  rate=0.05, jitter=0.0, normalise=True, bulk=True, seed=1, interval=None,
+                  spin=False, **run):
     run_keys = {"strain": 1.0, **run}
-    numerics = {"viscous_normalisation": normalise, "bulk_correction": bulk}
+    numerics = {"viscous_normalisation": normalise, "bulk_correction": bulk,
+                "spin_correction": spin}
     if interval is not None:
         numerics["normalisation_interval"] = interval
     return scene_from_dict({

@@ -46,21 +46,25 @@ PAIR_SEPARATION = np.array([0.3, 0.2, -0.1])
 
 
 def _two_particle_force(body_of, viscosity, velocity=((0.1, -0.2, 0.05), (0.0, 0.3, 0.0)),
-                        spin=((0.0, 0.0, 0.0),), both_ends=False):
+                        spin=((0.0, 0.0, 0.0),), both_ends=False, gradient=None):
     """Force on particle 0 from particle 1 (r_01 = PAIR_SEPARATION) through ``force_sums``
     (c = 0: viscous only), the bodies' angular velocities ``spin`` (B, 3); with ``both_ends``
-    the forces on both particles."""
+    the forces on both particles; with ``gradient`` (2, 9) the pair takes the spin correction
+    (``numerics.spin_correction``) from those velocity gradients."""
     d = PAIR_SEPARATION
     f = kernel_f(LUCY_3D, float(np.linalg.norm(d)), 1.0)
     velocity = np.asarray(velocity, dtype=float)
     width = force_width(False, False)
     acc = np.zeros(2 * width)
-    alpha, beta = viscous_weights(3, True)
+    correction = gradient is not None
+    alpha, beta = viscous_weights(3, True, correction)
+    gradient = np.zeros((2, 9)) if gradient is None else np.asarray(gradient, dtype=float)
     force_sums(np.array([0, 1, 1]), np.array([1, 1]), np.array([1]), np.array([[*d, f]]),
                np.array([1, 1]), np.zeros(1, dtype=np.int64), velocity, np.full(2, 4.0),
                np.full(2, 0.25), np.asarray(viscosity, dtype=float), 1.0, 4.0, 0.0, alpha,
                beta, -5.0 / 3.0, False, 0.0, np.asarray(body_of), np.asarray(spin, dtype=float),
-               np.zeros(2), acc, np.zeros((0, 2 * width)), np.array([0, 2]), np.zeros((1, 5)))
+               correction, gradient, np.zeros(2), acc, np.zeros((0, 2 * width)),
+               np.array([0, 2]), np.zeros((1, 5)))
     return acc.reshape(2, width)[:, :3] if both_ends else acc[:3]
 
 
@@ -164,3 +168,37 @@ def test_explicit_bulk_term_vanishes_in_simple_shear_with_gradient_across():
     g = np.zeros(9)
     g[3] = 1.0  # ∂_y v_x, ∇a along y
     assert explicit_bulk_term(0.0, 3.0, 0.0, g, 4.0) == pytest.approx((0.0, 0.0, 0.0))
+
+
+def _rotation_gradient(omega):
+    """g[3k + l] = ∂_k v_l of the rigid rotation v = ω × x."""
+    w = np.array([[0.0, -omega[2], omega[1]], [omega[2], 0.0, -omega[0]],
+                  [-omega[1], omega[0], 0.0]])  # v = w x, w[l, k] = ∂_k v_l
+    return w.T.reshape(9)
+
+
+def test_spin_correction_removes_the_viscous_force_of_rigid_rotation():
+    """With ``numerics.spin_correction`` a fluid pair moving in rigid rotation, v_01 = ω × r_01,
+    with the gradients of that rotation feels no viscous force (``viscous.local_spin``);
+    without it the β term pulls. A pure strain is felt through β doubled, and the pair stays
+    antisymmetric."""
+    omega = np.array([0.3, -0.2, 0.5])
+    rotating = (np.cross(omega, PAIR_SEPARATION), (0.0, 0.0, 0.0))
+    g = np.tile(_rotation_gradient(omega), (2, 1))
+    np.testing.assert_allclose(_two_particle_force([-1, -1], [1.0, 1.0], rotating, gradient=g),
+                               0.0, atol=1e-15)
+    assert np.linalg.norm(_two_particle_force([-1, -1], [1.0, 1.0], rotating)) > 1e-3
+    strain = np.array([[0.0, 0.4, 0.0], [0.4, 0.0, 0.1], [0.0, 0.1, -0.2]])
+    straining = (strain @ PAIR_SEPARATION, (0.0, 0.0, 0.0))
+    both = _two_particle_force([-1, -1], [1.0, 1.0], straining, both_ends=True,
+                               gradient=np.tile(strain.T.reshape(9), (2, 1)))
+    np.testing.assert_allclose(both[0], -both[1], rtol=1e-14)
+    alpha, beta = viscous_weights(3, True)
+    r = PAIR_SEPARATION
+    u = strain @ r
+    plain = alpha * (r @ u) * r / (r @ r) + beta * u
+    corrected = alpha * (r @ u) * r / (r @ r) + 2.0 * beta * u
+    scale = both[0] / corrected
+    np.testing.assert_allclose(scale, scale[0], rtol=1e-12)
+    np.testing.assert_allclose(_two_particle_force([-1, -1], [1.0, 1.0], straining),
+                               scale[0] * plain, rtol=1e-12)

@@ -17,7 +17,9 @@ of particles of two bodies takes at each end the μ̂ of the fluid beside that p
 term of a rotating body would give a spurious torque. The simulation's list does not hold
 them (``group`` of ``neighbours.build_neighbour_list``); the loop also skips them, for tables
 built without groups. For the same reason a pair with a body particle takes v relative to the
-body's rigid rotation, v − Ω_B × r (``viscous.spin_free_velocity``; Ω_B from ``body_spin``).
+body's rigid rotation, v − Ω_B × r (``viscous.spin_free_velocity``; Ω_B from ``body_spin``),
+and with ``numerics.spin_correction`` a fluid–fluid pair takes v relative to the mean of the
+two particles' local spin ½ ∇×v (``viscous.local_spin``), which makes the stress symmetric.
 With the
 bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
 ∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
@@ -52,8 +54,8 @@ from numba import njit, prange
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.terms.pressure import pressure_pair, pressure_term
-from suspsim.sph.terms.viscous import (explicit_bulk_term, pair_viscosity, spin_free_velocity,
-                                      viscous_pair)
+from suspsim.sph.terms.viscous import (explicit_bulk_term, local_spin, pair_viscosity,
+                                      spin_free_velocity, viscous_pair)
 
 
 def force_width(bulk_gradient: bool, shifting: bool) -> int:
@@ -69,7 +71,7 @@ VXX, VYY, VZZ, VXY, VYX = range(5)
 @njit(inline="always", **JIT_OPTIONS)
 def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity,
                 volume, pressure, viscosity, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
-                body_of, body_spin, acc, virial_row):
+                body_of, body_spin, spin_correction, gradient, acc, virial_row):
     """acc[w i ...] += forces, ∇a sums and ∇C (layout of :func:`force_width`) of particles
     lo..hi−1, both ends; virial_row +=."""
     n = volume.shape[0]
@@ -85,6 +87,9 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
         vol_i = volume[i]
         body_i = body_of[i]
         vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
+        oxi = oyi = ozi = 0.0
+        if spin_correction and body_i < 0:
+            oxi, oyi, ozi = local_spin(gradient[i])
         fxi = fyi = fzi = 0.0
         gxi = gyi = gzi = 0.0
         cxi = cyi = czi = 0.0
@@ -113,6 +118,12 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
                     mu_b = mu_a
                 elif body_j < 0:
                     mu_a = mu_b
+            elif spin_correction:
+                oxj, oyj, ozj = local_spin(gradient[j])
+                wx, wy, wz = 0.5 * (oxi + oxj), 0.5 * (oyi + oyj), 0.5 * (ozi + ozj)
+                vx -= wy * dz - wz * dy
+                vy -= wz * dx - wx * dz
+                vz -= wx * dy - wy * dx
             wx, wy, wz = viscous_pair(pair_viscosity(mu_a, mu_b), f * vol_i * vol_j,
                                       dx, dy, dz, r2, vx, vy, vz, alpha, beta)
             fx = kp * dx + wx
@@ -169,13 +180,15 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
 @njit(parallel=True, **JIT_OPTIONS)
 def force_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity, rho, volume,
                viscosity, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
-               body_of, body_spin, pressure, acc, scratch, bounds, virial):
+               body_of, body_spin, spin_correction, gradient, pressure, acc, scratch, bounds,
+               virial):
     """acc (w N,) = pair forces, ∇a sums and ∇C of every particle, w = :func:`force_width`
     (columns beyond the force and, with ``bulk_gradient``, the ∇a sums take ∇C); ``scratch``
     rows of w N; virial (T, 5) per chunk; ``pressure`` (N,) scratch for the particles'
     m² P/ρ²; ``body_of`` (N,) the rigid body of each particle, −1 for fluid; ``body_spin``
     (B, 3) the bodies' angular velocities [τ⁻¹] (:func:`spin_free_velocity`; any (≥ 1, 3)
-    array without bodies)."""
+    array without bodies); ``spin_correction`` takes fluid–fluid pairs' v relative to the
+    mean local spin of the two particles (``viscous.local_spin``) from ``gradient`` (N, 9)."""
     for i in prange(rho.shape[0]):
         pressure[i] = pressure_term(rho[i], rho_eq, c2, mass)
     n_chunks = scratch.shape[0] + 1
@@ -189,14 +202,15 @@ def force_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, veloci
             acc[:] = 0.0
             _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image,
                         velocity, volume, pressure, viscosity, alpha, beta, bulk_factor,
-                        bulk_gradient, shear_ly, body_of, body_spin, acc, virial[0])
+                        bulk_gradient, shear_ly, body_of, body_spin, spin_correction, gradient,
+                        acc, virial[0])
         else:
             buffer = scratch[c - 1]
             buffer[width * lo:] = 0.0
             _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_image,
                         velocity, volume, pressure, viscosity, alpha, beta, bulk_factor,
-                        bulk_gradient, shear_ly, body_of, body_spin, buffer,
-                        virial[c])
+                        bulk_gradient, shear_ly, body_of, body_spin, spin_correction, gradient,
+                        buffer, virial[c])
     add_chunk_buffers(acc, scratch, bounds, n_chunks, width)
 
 

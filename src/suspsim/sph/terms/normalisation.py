@@ -69,8 +69,18 @@ def quadratic_form(s, xx, yy, zz, xy, xz, yz):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def moment_dissipation(g, moment):
-    """Σ_j V_j F |L r_ij|² = (L Lᵀ) : M2, the β part of D_i without a pair loop.
+def _entry(g, k, m, symmetric):
+    """g[3k + m], or its symmetric part ½ (g[3k + m] + g[3m + k]) (the strain rate)."""
+    if symmetric:
+        return 0.5 * (g[3 * k + m] + g[3 * m + k])
+    return g[3 * k + m]
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def moment_dissipation(g, moment, symmetric=False):
+    """Σ_j V_j F |L r_ij|² = (L Lᵀ) : M2, the β part of D_i without a pair loop; with
+    ``symmetric`` (``numerics.spin_correction``, whose β term sees (L − W) r = S r) the same
+    with S for L.
 
     |L r|² = Σ_km r_k r_m C_km with C_km = Σ_l g[3k + l] g[3m + l]; ``moment`` is M2 =
     Σ_j V_j F r r stored as (xx, yy, zz, xy, xz, yz).
@@ -78,7 +88,9 @@ def moment_dissipation(g, moment):
     c = 0.0
     for k in range(3):
         for m in range(3):
-            ckm = g[3 * k] * g[3 * m] + g[3 * k + 1] * g[3 * m + 1] + g[3 * k + 2] * g[3 * m + 2]
+            ckm = 0.0
+            for n in range(3):
+                ckm += _entry(g, k, n, symmetric) * _entry(g, m, n, symmetric)
             if k == m:
                 c += ckm * moment[k]
             else:
@@ -87,13 +99,16 @@ def moment_dissipation(g, moment):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def continuum_dissipation(g, alpha, beta, dimension):
-    """D_c = α ((tr L)² + 2 S:S)/(d + 2) + β L:L (module docstring)."""
+def continuum_dissipation(g, alpha, beta, dimension, symmetric=False):
+    """D_c = α ((tr L)² + 2 S:S)/(d + 2) + β L:L (module docstring); β S:S with
+    ``symmetric`` (:func:`moment_dissipation`)."""
     tr = g[0] + g[4] + g[8]
     sxy = 0.5 * (g[1] + g[3])
     sxz = 0.5 * (g[2] + g[6])
     syz = 0.5 * (g[5] + g[7])
     ss = g[0] * g[0] + g[4] * g[4] + g[8] * g[8] + 2.0 * (sxy * sxy + sxz * sxz + syz * syz)
+    if symmetric:
+        return alpha * (tr * tr + 2.0 * ss) / (dimension + 2.0) + beta * ss
     ll = 0.0
     for k in range(9):
         ll += g[k] * g[k]

@@ -199,8 +199,8 @@ def _gradient_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, ve
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def _gradient_row(i, acc, dimension, normalise, beta, body_of, gradient, inverse_moment,
-                  moment_trace, gdot, strain, dissipation):
+def _gradient_row(i, acc, dimension, normalise, beta, symmetric, body_of, gradient,
+                  inverse_moment, moment_trace, gdot, strain, dissipation):
     """Particle i of :func:`_gradient_finish` without μ."""
     sums = acc[GRADIENT_WIDTH * i:GRADIENT_WIDTH * (i + 1)]
     moment = sums[9:]
@@ -224,16 +224,18 @@ def _gradient_row(i, acc, dimension, normalise, beta, body_of, gradient, inverse
         strain_form(g, strain[i])
         if dimension == 2:
             moment[ZZ] = 0.0
-        dissipation[i] = beta * moment_dissipation(g, moment)
+        dissipation[i] = beta * moment_dissipation(g, moment, symmetric)
 
 
 @njit(parallel=True, **JIT_OPTIONS)
-def _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise, beta, body_of,
-                     gradient, inverse_moment, moment_trace, gdot, viscosity, strain, dissipation):
+def _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise, beta, symmetric,
+                     body_of, gradient, inverse_moment, moment_trace, gdot, viscosity, strain,
+                     dissipation):
     """Per particle: g = M2⁻¹ G, tr M2, γ̇ and (non-Newtonian) μ(γ̇) [SPEC §2.5, §1.1]; with
     ``normalise`` also the strain form of g and the β part β (L Lᵀ):M2 of D_i
-    (``normalisation``). A rigid-body particle (``body_of`` ≥ 0) gets g = 0, M2⁻¹ = 0, γ̇ = 0:
-    it has no pairs inside its body, so its M2 is one-sided or zero (``integrator``).
+    (``normalisation``; with ``symmetric``, ``numerics.spin_correction``, β (S Sᵀ):M2). A
+    rigid-body particle (``body_of`` ≥ 0) gets g = 0, M2⁻¹ = 0, γ̇ = 0: it has no pairs
+    inside its body, so its M2 is one-sided or zero (``integrator``).
 
     Measured on the 32,768-particle Papanastasiou bench box (one thread): 1.21 ms with μ in
     the particle loop, 0.93 ms with μ in a loop of its own (the law's call, expm1 here, 0.6 →
@@ -242,8 +244,8 @@ def _gradient_finish(acc, dimension, law_code, law_params, newtonian, normalise,
     """
     n = gradient.shape[0]
     for i in prange(n):
-        _gradient_row(i, acc, dimension, normalise, beta, body_of, gradient, inverse_moment,
-                      moment_trace, gdot, strain, dissipation)
+        _gradient_row(i, acc, dimension, normalise, beta, symmetric, body_of, gradient,
+                      inverse_moment, moment_trace, gdot, strain, dissipation)
     if not newtonian:
         for i in prange(n):
             viscosity[i] = viscosity_kernel(law_code, law_params, gdot[i])
@@ -289,7 +291,7 @@ def _dissipation_sums(start, pair_end, pair_j, geometry, volume, strain, acc, sc
 
 @njit(parallel=True, **JIT_OPTIONS)
 def _normalisation_finish(acc, dissipation, gradient, moment_trace, viscosity, alpha, beta,
-                          dimension, body_of, factor, viscosity_hat):
+                          symmetric, dimension, body_of, factor, viscosity_hat):
     """D_i = α acc_i + β (L Lᵀ):M2 (``dissipation``), s_i = D_i/D_c and μ̂_i = μ_i/s_i of the
     fluid particles; a rigid-body particle (``body_of`` ≥ 0) keeps its μ̂, the fluid's beside
     it (``density.body_particle_density``)."""
@@ -301,7 +303,8 @@ def _normalisation_finish(acc, dissipation, gradient, moment_trace, viscosity, a
         for k in range(9):
             norm2 += g[k] * g[k]
         s = normalisation_factor(alpha * acc[i] + dissipation[i],
-                                 continuum_dissipation(g, alpha, beta, dimension), norm2,
+                                 continuum_dissipation(g, alpha, beta, dimension, symmetric),
+                                 norm2,
                                  moment_trace[i], dimension)
         factor[i] = s
         viscosity_hat[i] = viscosity[i] / s

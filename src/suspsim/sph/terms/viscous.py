@@ -32,12 +32,15 @@ from numba import njit
 from suspsim.sph import JIT_OPTIONS
 
 
-def viscous_weights(dimension: int, bulk_correction: bool) -> tuple[float, float]:
-    """(α, β) of the combined pair force for ``dimension`` with or without B (module docstring)."""
+def viscous_weights(dimension: int, bulk_correction: bool,
+                    spin_correction: bool = False) -> tuple[float, float]:
+    """(α, β) of the combined pair force for ``dimension`` with or without B (module
+    docstring); with ``spin_correction`` β is doubled (:func:`local_spin`)."""
     d = float(dimension)
     if not bulk_correction:
         return d + 2.0, 0.0
-    return (d + 2.0) * (d - 2.0) / (2.0 * d), (d + 2.0) / (2.0 * d)
+    beta = (d + 2.0) / (2.0 * d)
+    return (d + 2.0) * (d - 2.0) / (2.0 * d), 2.0 * beta if spin_correction else beta
 
 
 def bulk_factor(dimension: int) -> float:
@@ -86,9 +89,9 @@ def spin_free_velocity(body_spin, body_i, body_j, dx, dy, dz, vx, vy, vz):
     torque on it, and a torque-free sphere in simple shear spun at 1.36 × γ̇/2 instead of γ̇/2
     (one sphere, a = 2.4 h, φ = 0.03, README). Taking v relative to the body's rigid rotation
     removes that moment from the fluid–body pairs: a fluid particle moving rigidly with the body
-    feels no viscous force from it (the sphere then turned at 1.26 × γ̇/2; the fluid–fluid pairs
-    of the one-sided neighbourhood beside the body carry the same term, README). The α term is
-    unchanged (r·(w × r) = 0); the pair force stays antisymmetric, so momentum is conserved.
+    feels no viscous force from it (the sphere then turned at 1.26 × γ̇/2; the rest is the same
+    term in the fluid–fluid pairs, which :func:`local_spin` removes: 0.995 × γ̇/2). The α term
+    is unchanged (r·(w × r) = 0); the pair force stays antisymmetric, so momentum is conserved.
     """
     if body_i >= 0 and body_j >= 0:
         wx = 0.5 * (body_spin[body_i, 0] + body_spin[body_j, 0])
@@ -98,6 +101,30 @@ def spin_free_velocity(body_spin, body_i, body_j, dx, dy, dz, vx, vy, vz):
         b = body_i if body_i >= 0 else body_j
         wx, wy, wz = body_spin[b, 0], body_spin[b, 1], body_spin[b, 2]
     return (vx - (wy * dz - wz * dy), vy - (wz * dx - wx * dz), vz - (wx * dy - wy * dx))
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def local_spin(g):
+    """Angular velocity ½ ∇×v [τ⁻¹] of a particle from its corrected gradient g[3k + l] =
+    ∂_k v_l (``velocity_pass``).
+
+    Why [derived; ``numerics.spin_correction``, a [choice] beyond SPEC §2.3–2.4]: the β v term
+    of :func:`viscous_pair` makes the continuum stress of the pair sum non-symmetric. For a
+    linear field v_ij = L r_ij, the sums over a neighbourhood (Σ F r r = K I/d, the fourth
+    moment K (δδ + δδ + δδ)/(d(d + 2))) give the stress μK [β/d L + α/(d(d + 2)) (L + Lᵀ +
+    tr L I)]: its antisymmetric part β/(2d) μK (L − Lᵀ) follows the vorticity, as in the
+    Español–Revenga form, which does not conserve angular momentum (Müller, Fedosov &
+    Karniadakis, J. Comput. Phys. 281, 301 (2015)). In a suspension the fluid then carries
+    less shear stress wherever it turns with the bodies, and torque-free bodies spin too fast.
+    Taking the β term of v_ij − w̄ × r_ij, w̄ the mean of the two particles' ½ ∇×v, leaves
+    (L − W) r = E r: the stress μK [(β/d + 2α/(d(d + 2))) E + α/(d(d + 2)) tr E I] is
+    symmetric. Its divergence keeps μ ∇²v when β is doubled (α unchanged), so the shear
+    viscosity is the same, and the bulk viscosity becomes ζ = 5μ/6 in 3D (μ in 2D) instead of
+    seed 000's 0. Unlike the particle spins of Müller et al. this adds no variable: w is
+    slaved to the local vorticity, so angular momentum is conserved to first order (exactly
+    for a linear field). Rigid rotation then has no viscous force at all.
+    """
+    return 0.5 * (g[5] - g[7]), 0.5 * (g[6] - g[2]), 0.5 * (g[1] - g[3])
 
 
 @njit(inline="always", **JIT_OPTIONS)
