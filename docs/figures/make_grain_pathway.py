@@ -52,7 +52,8 @@ from suspsim.sph.inclusions import scene_packing
 from suspsim.sph.simulation import Simulation
 from suspsim.sph.stress import VXY, kinetic_tensor
 from suspsim.validation.flows import couette_viscosity_ratio
-from suspsim.validation.suspension import RATE, HealthWatch, parse_overrides, suspension_scene
+from suspsim.validation.suspension import (RATE, HealthWatch, add_run_options, overrides_text,
+                                           parse_overrides, suspension_scene)
 
 BOX = 16.875
 RADIUS = 2.5
@@ -212,8 +213,6 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--phi", type=float, default=0.5)
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
-    parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 4.0],
-                        metavar=("TRANSIENT", "UNITS"))
     parser.add_argument("--pathways", nargs="+", default=["sphere", "grain"],
                         choices=("sphere", "grain"))
     parser.add_argument("--elongation", type=float, nargs=2, default=None,
@@ -223,14 +222,13 @@ def main() -> None:
     parser.add_argument("--no-run", action="store_true",
                         help="checks and step-0 diagnostics only")
     parser.add_argument("--out", default=None, help="directory for the packing files")
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="a scene key for every run (repeatable)")
+    add_run_options(parser)
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
     overrides = parse_overrides(args.set)
     out = Path(args.out or tempfile.mkdtemp(prefix="grain_pathway_"))
     out.mkdir(parents=True, exist_ok=True)
-    settings = "".join(f", {key} = {value}" for key, value in overrides.items())
+    settings = overrides_text(overrides)
     print(f"φ = {args.phi}, box {BOX} h, a = {RADIUS} h, strain {transient:g} + {units}"
           f"{settings}; packings in {out}", flush=True)
     rows = []

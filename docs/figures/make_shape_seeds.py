@@ -23,7 +23,8 @@ import time
 import numpy as np
 
 from suspsim.errors import NumericalError
-from suspsim.validation.suspension import RATE, parse_overrides, relative_viscosity
+from suspsim.validation.suspension import (RATE, add_run_options, overrides_text,
+                                           parse_overrides, relative_viscosity)
 
 BOX = 16.875
 RADIUS = 2.5
@@ -33,19 +34,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--phi", type=float, default=0.3)
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
-    parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 4.0],
-                        metavar=("TRANSIENT", "UNITS"))
     parser.add_argument("--box", type=float, default=BOX, help=f"cube side [h] (default {BOX})")
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="a scene key for every run, e.g. run.dt=0.1 or "
-                             "inclusions.lubrication.repulsion=1e5 (repeatable)")
+    add_run_options(parser, example=", e.g. run.dt=0.1 or inclusions.lubrication.repulsion=1e5")
     parser.add_argument("--shapes", nargs="+", default=["sphere", "sand"],
                         choices=("sphere", "sand"))
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
     overrides = parse_overrides(args.set)
     means = {}
-    settings = "".join(f", {key} = {value}" for key, value in overrides.items())
+    settings = overrides_text(overrides)
     print(f"φ = {args.phi}, box {args.box} h, a = {RADIUS} h, μ = 1, γ̇ = {RATE}, strain "
           f"{transient:g} + {units}{settings}\n| shape | seed | η_r | CPU [s] | density error | "
           f"smallest gap [h] | body speed / wall speed |\n|---|---|---|---|---|---|---|",

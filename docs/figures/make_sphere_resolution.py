@@ -17,7 +17,8 @@ import argparse
 
 from suspsim.errors import NumericalError
 from suspsim.rheology.suspension import published_envelope
-from suspsim.validation.suspension import NUMBER_DENSITY, parse_overrides, relative_viscosity
+from suspsim.validation.suspension import (NUMBER_DENSITY, add_run_options, overrides_text,
+                                           parse_overrides, relative_viscosity)
 
 BOX_PER_RADIUS = 6.0
 SPACING = NUMBER_DENSITY ** (-1.0 / 3.0)
@@ -29,14 +30,11 @@ def main() -> None:
     parser.add_argument("--phi", type=float, default=0.4)
     parser.add_argument("--radii", type=float, nargs="+", default=[2.5, 3.333, 4.167])
     parser.add_argument("--seeds", type=int, nargs="+", default=[1])
-    parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 4.0],
-                        metavar=("TRANSIENT", "UNITS"))
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="a scene key for every run (repeatable)")
+    add_run_options(parser)
     args = parser.parse_args()
     transient, units = args.strain[0], int(args.strain[1])
     overrides = parse_overrides(args.set)
-    settings = "".join(f", {key} = {value}" for key, value in overrides.items())
+    settings = overrides_text(overrides)
     low, high = published_envelope(args.phi)
     print(f"φ = {args.phi} (published envelope {low:.2f}–{high:.2f}), box {BOX_PER_RADIUS:g} a, "
           f"strain {transient:g} + {units}{settings}\n| a [h] | box [h] | seed | φ packed | η_r | "

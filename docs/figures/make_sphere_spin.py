@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from suspsim.validation.suspension import (RATE, parse_overrides, sampled_run,
-                                           suspension_scene)
+from suspsim.validation.suspension import (RATE, add_run_options, overrides_text,
+                                           parse_overrides, sampled_run, suspension_scene)
 
 RADIUS = 2.5
 
@@ -27,14 +27,11 @@ def main() -> None:
     parser.add_argument("--box", type=float, default=12.5, help="cube side [h]")
     parser.add_argument("--radius", type=float, default=RADIUS, help="sphere radius a [h]")
     parser.add_argument("--seeds", type=int, nargs="+", default=[1])
-    parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 2.0],
-                        metavar=("TRANSIENT", "UNITS"))
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="a scene key for every run, e.g. numerics.shifting=0 (repeatable)")
+    add_run_options(parser, units=2.0, example=", e.g. numerics.shifting=0")
     args = parser.parse_args()
     transient, units = args.strain
     overrides = parse_overrides(args.set)
-    settings = "".join(f", {key} = {value}" for key, value in overrides.items())
+    settings = overrides_text(overrides)
     print(f"φ = {args.phi}, box {args.box} h, a = {args.radius} h, γ̇ = {RATE}, strain "
           f"{transient:g} + {units:g}{settings}\n| seed | bodies | mean Ω/(γ̇/2) (x, y, z) | "
           f"bodies' Ω_z/(γ̇/2) | CPU [s] |\n|---|---|---|---|---|", flush=True)

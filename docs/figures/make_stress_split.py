@@ -18,8 +18,8 @@ import numpy as np
 from numba import njit
 
 from suspsim.sph.terms.force_pass import VXY
-from suspsim.validation.suspension import (RATE, parse_overrides, sampled_run,
-                                           suspension_scene)
+from suspsim.validation.suspension import (RATE, add_run_options, overrides_text,
+                                           parse_overrides, sampled_run, suspension_scene)
 
 RADIUS = 2.5
 
@@ -48,10 +48,7 @@ def main() -> None:
     parser.add_argument("--phi", type=float, default=0.1)
     parser.add_argument("--box", type=float, default=15.0, help="cube side [h]")
     parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--strain", type=float, nargs=2, default=[1.0, 4.0],
-                        metavar=("TRANSIENT", "UNITS"))
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="a scene key, e.g. numerics.wi_target=1e-4 (repeatable)")
+    add_run_options(parser, example=", e.g. numerics.wi_target=1e-4")
     args = parser.parse_args()
     transient, units = args.strain
     overrides = parse_overrides(args.set)
@@ -68,7 +65,7 @@ def main() -> None:
     # σ_xy = −Π_xy and Π = (kinetic + virial)/V.
     total, fluid, mixed, pairs, centres, lubrication = (
         -np.mean(rows, axis=0) / (scene.volume * RATE * float(scene.fluid.law.viscosity(RATE))))
-    settings = "".join(f", {key} = {value}" for key, value in overrides.items())
+    settings = overrides_text(overrides)
     print(f"φ = {args.phi}, box {args.box} h, seed {args.seed}, strain {transient:g} + "
           f"{units:g}{settings}: σ_xy/(μγ̇) = {total:.4f}; fluid–fluid pressure {fluid:+.4f}, "
           f"fluid–body pressure {mixed:+.4f}; all pairs {pairs:.4f}, body particles to their "

@@ -7,6 +7,7 @@ a relaxed start and the inclusions' defaults.
 """
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import time
@@ -67,6 +68,21 @@ class HealthWatch:
         wall_speed = 0.5 * scene.flow.shear_rate * scene.box[1]
         self.body_speed = max(self.body_speed,
                               float(np.sqrt((peculiar ** 2).sum(axis=1)).max()) / wall_speed)
+
+
+def add_run_options(parser: argparse.ArgumentParser, *, units: float = 4.0,
+                    example: str = "") -> None:
+    """A figure script's ``--strain TRANSIENT UNITS`` (default 1 and ``units``) and repeatable
+    ``--set KEY=VALUE`` (:func:`parse_overrides`; ``example`` goes into its help)."""
+    parser.add_argument("--strain", type=float, nargs=2, default=[1.0, units],
+                        metavar=("TRANSIENT", "UNITS"))
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help=f"a scene key for every run{example} (repeatable)")
+
+
+def overrides_text(overrides: Mapping[str, Any]) -> str:
+    """", KEY = VALUE" for each override, for a script's header line."""
+    return "".join(f", {key} = {value}" for key, value in overrides.items())
 
 
 def parse_overrides(items: Sequence[str]) -> dict[str, Any]:

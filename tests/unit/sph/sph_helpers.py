@@ -51,6 +51,18 @@ def evaluate(sim, velocity, viscosity, normalise, bulk_gradient=False):
     return xi, out * sim._rho[:, None], sim._gradient.reshape(-1, 3, 3).copy(), sim._gdot.copy()
 
 
+def shear_squared(xi):
+    """v_x = y²: μ∇²v = 2μ e_x."""
+    v = np.zeros_like(xi)
+    v[:, 0] = xi[:, 1] ** 2
+    return v
+
+
+def constant(xi):
+    """μ = 1 everywhere."""
+    return np.ones(len(xi))
+
+
 def interior(sim, xi, margin=1.25):
     """Particles whose whole neighbourhood lies inside the box (no image pairs)."""
     half = 0.5 * np.array(sim.scene.box)

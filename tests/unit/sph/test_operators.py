@@ -10,26 +10,16 @@ resolution (more particles per support h).
 import numpy as np
 import pytest
 
-from sph_helpers import evaluate, interior, relaxed_simulation
+from sph_helpers import constant, evaluate, interior, relaxed_simulation, shear_squared
 from suspsim.sph.density import GEOMETRY_DTYPE
 
 RESOLUTIONS = (4.096, 8.0, 27.0)  # particles per h³; lattice spacings 0.625, 0.5, 1/3 h
-
-
-def shear_squared(xi):
-    v = np.zeros_like(xi)
-    v[:, 0] = xi[:, 1] ** 2
-    return v
 
 
 def linear_shear(xi):
     v = np.zeros_like(xi)
     v[:, 0] = xi[:, 1]
     return v
-
-
-def constant(xi):
-    return np.ones(len(xi))
 
 
 def linear_viscosity(xi):

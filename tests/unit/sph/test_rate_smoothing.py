@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from sph_helpers import evaluate, interior, relaxed_simulation
+from sph_helpers import constant, evaluate, interior, relaxed_simulation
 from suspsim.rheology.laws import make_law
 from suspsim.scene import scene_from_dict
 from suspsim.sph.density import GEOMETRY_DTYPE
@@ -13,10 +13,6 @@ from suspsim.sph.kernels import kernel_code, lucy_w_3d
 from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
 
 POWER_LAW = make_law("power_law", {"K": 1.0, "n": 0.5})
-
-
-def constant(xi):
-    return np.ones(len(xi))
 
 
 def smoothed(sim):

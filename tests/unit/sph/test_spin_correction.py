@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from sph_helpers import couette_scene, evaluate, interior, relaxed_simulation
+from sph_helpers import (constant, couette_scene, evaluate, interior, relaxed_simulation,
+                         shear_squared)
 from suspsim.errors import InputError
 from suspsim.sph.simulation import Simulation
 from suspsim.sph.terms.force_pass import VXY, VYX
@@ -26,7 +27,7 @@ def _shear_virial(spin, jitter):
         v[:, 0] = RATE * xi[:, 1]
         return v
 
-    evaluate(sim, profile, lambda xi: np.ones(len(xi)), normalise=True)
+    evaluate(sim, profile, constant, normalise=True)
     virial = sim._virial.sum(axis=0)
     return -virial[VXY] / (scene.volume * RATE), -virial[VYX] / (scene.volume * RATE)
 
@@ -50,13 +51,7 @@ def test_the_corrected_operator_keeps_mu_laplacian():
     """v_x = y²: μ∇²v = 2 in the interior of the lattice with the normalisation, as without the
     correction (``test_operators``)."""
     sim = relaxed_simulation(3, 5.0, 4.096, spin=True)
-
-    def shear_squared(xi):
-        v = np.zeros_like(xi)
-        v[:, 0] = xi[:, 1] ** 2
-        return v
-
-    xi, force, _, _ = evaluate(sim, shear_squared, lambda x: np.ones(len(x)), normalise=True)
+    xi, force, _, _ = evaluate(sim, shear_squared, constant, normalise=True)
     inside = interior(sim, xi)
     np.testing.assert_allclose(force[inside, 0], 2.0, rtol=2e-3)
     np.testing.assert_allclose(force[inside, 1:], 0.0, atol=2e-3)

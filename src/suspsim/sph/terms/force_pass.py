@@ -55,7 +55,7 @@ from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.terms.pressure import pressure_pair, pressure_term
 from suspsim.sph.terms.viscous import (explicit_bulk_term, local_spin, pair_viscosity,
-                                      spin_free_velocity, viscous_pair)
+                                      spin_free_velocity, viscous_pair, without_rotation)
 
 
 def force_width(bulk_gradient: bool, shifting: bool) -> int:
@@ -120,10 +120,8 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
                     mu_a = mu_b
             elif spin_correction:
                 oxj, oyj, ozj = local_spin(gradient[j])
-                wx, wy, wz = 0.5 * (oxi + oxj), 0.5 * (oyi + oyj), 0.5 * (ozi + ozj)
-                vx -= wy * dz - wz * dy
-                vy -= wz * dx - wx * dz
-                vz -= wx * dy - wy * dx
+                vx, vy, vz = without_rotation(0.5 * (oxi + oxj), 0.5 * (oyi + oyj),
+                                              0.5 * (ozi + ozj), dx, dy, dz, vx, vy, vz)
             wx, wy, wz = viscous_pair(pair_viscosity(mu_a, mu_b), f * vol_i * vol_j,
                                       dx, dy, dz, r2, vx, vy, vz, alpha, beta)
             fx = kp * dx + wx

@@ -100,6 +100,13 @@ def spin_free_velocity(body_spin, body_i, body_j, dx, dy, dz, vx, vy, vz):
     else:
         b = body_i if body_i >= 0 else body_j
         wx, wy, wz = body_spin[b, 0], body_spin[b, 1], body_spin[b, 2]
+    return without_rotation(wx, wy, wz, dx, dy, dz, vx, vy, vz)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def without_rotation(wx, wy, wz, dx, dy, dz, vx, vy, vz):
+    """v_ij − w × r_ij [h τ⁻¹]: the pair's velocity relative to a rigid rotation at angular
+    velocity w [τ⁻¹] (:func:`spin_free_velocity`, :func:`local_spin`)."""
     return (vx - (wy * dz - wz * dy), vy - (wz * dx - wx * dz), vz - (wx * dy - wy * dx))
 
 
