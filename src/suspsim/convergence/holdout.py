@@ -15,6 +15,12 @@ chosen (geometry and step count; of the variants with the same cost, the one the
 most accurate) expected to cost less than :data:`COST_SLACK` × paid/2, unless it ran already,
 cheapest first, at most ``max_runs`` of them.
 
+CPU times of separate runs on a shared machine move by about ±20 % (another process's memory
+traffic, cache state), enough to push a 1.8× case past 2×. So when the ratio exceeds
+:data:`COST_RATIO`, the runs it is made of (the attempts and the cheapest configuration meeting
+ε) run once more and each keeps the smaller of its two CPU times, the usual best-of-n timing;
+``retimed`` says whether that happened.
+
 Command (writes every run as a case Dataset, the attempts first, with the check in its
 attributes)::
 
@@ -29,7 +35,6 @@ import sys
 import time
 from typing import Any, Iterable, Sequence
 
-import numpy as np
 import xarray as xr
 
 from suspsim.convergence.cases import Case, get_case
@@ -83,6 +88,25 @@ def _measure(case: Case, settings: dict[str, Any]) -> dict[str, Any]:
     return record
 
 
+def _retime(case: Case, records: list[dict[str, Any]], indices: Iterable[int]) -> None:
+    """Run ``records[i]`` again for each i in ``indices`` and keep the smaller CPU time [s]; the
+    runs are deterministic, so only the timing can differ."""
+    for i in indices:
+        again = _measure(case, {k: records[i][k] for k in case.settings()})
+        records[i]["cpu_time"] = min(records[i]["cpu_time"], again["cpu_time"])
+
+
+def _ratio(records: list[dict[str, Any]], n: int, tolerance: float) -> tuple[float, float, int]:
+    """Paid CPU time of the first ``n`` records [s], the ratio of it to the cheapest record
+    whose bound meets ``tolerance`` [1] (nan if none) and that record's index (-1 if none)."""
+    paid = float(sum(r["cpu_time"] for r in records[:n]))
+    meets = [i for i, r in enumerate(records) if _bound(r) <= tolerance]
+    if not meets:
+        return paid, math.nan, -1
+    cheapest = min(meets, key=lambda i: records[i]["cpu_time"])
+    return paid, paid / records[cheapest]["cpu_time"], cheapest
+
+
 def _bound(record: dict[str, Any]) -> float:
     """:func:`~.study.error_bound` of a record [1]; inf for a blow-up."""
     if "failure" in record:
@@ -97,7 +121,7 @@ def check(case_name: str, tolerance: float, *, max_runs: int = MAX_COMPARISONS,
     and it carries ``tolerance``, ``mode``, ``attempts``, ``expected_error`` (of the answer,
     calibrated in the verified mode, inflated in the bound mode), ``picked_error_bound``,
     ``picked_cpu_time``, ``paid_cpu_time``, ``cheapest_meeting_cpu_time``, ``cost_ratio``,
-    ``passed`` (1/0) and ``calibration`` or ``inflation`` [1] as attributes."""
+    ``passed`` (1/0), ``retimed`` (1/0) and ``calibration`` or ``inflation`` [1] as attributes."""
     model = model or load_model()
     case = get_case(case_name)
 
@@ -121,17 +145,20 @@ def check(case_name: str, tolerance: float, *, max_runs: int = MAX_COMPARISONS,
     paid = float(sum(r["cpu_time"] for r in records))
     records += [_measure(case, s) for s in comparison_settings(
         case, model, COST_SLACK * paid / COST_RATIO, done, max_runs)]
+    paid, ratio, best = _ratio(records, n, tolerance)
+    retimed = ratio > COST_RATIO
+    if retimed:
+        _retime(case, records, sorted(set(range(n)) | {best}))
+        paid, ratio, best = _ratio(records, n, tolerance)
     ds = case_dataset(case, records)
     bound, cpu = ds["error_bound"].values, ds["cpu_time"].values
-    meets = np.flatnonzero(bound <= tolerance)
-    cheapest = float(cpu[meets].min()) if meets.size else float("nan")
-    ratio = paid / cheapest if meets.size else float("nan")
+    cheapest = float(cpu[best]) if best >= 0 else math.nan
     passed = bool(bound[n - 1] <= tolerance and ratio <= COST_RATIO)
     ds.attrs.update(tolerance=float(tolerance), mode="verified" if verified else "bound",
                     attempts=n, expected_error=float(expected),
                     picked_error_bound=float(bound[n - 1]), picked_cpu_time=float(cpu[n - 1]),
                     paid_cpu_time=paid, cheapest_meeting_cpu_time=cheapest, cost_ratio=ratio,
-                    passed=int(passed), error_model=json.dumps(model.provenance), **scale)
+                    passed=int(passed), retimed=int(retimed), error_model=json.dumps(model.provenance), **scale)
     log.info("%s at %g (%s): %d run(s), answer bound %.4g (expected %.4g), paid %.3g s CPU, "
              "cheapest meeting %.3g s, ratio %.2f: %s", case_name, tolerance, ds.attrs["mode"],
              n, bound[n - 1], expected, paid, cheapest, ratio, "pass" if passed else "FAIL")
