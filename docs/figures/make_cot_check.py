@@ -2,20 +2,22 @@
 contact friction, over several packings.
 
     python docs/figures/make_cot_check.py [--friction 0.5] [--x 1] [--phi 0.4] [--seeds 1 2]
+        [--strain 1 4] [--set KEY=VALUE ...]
 
 For each packing seed: the Newtonian η_r g of spheres a = 2.5 h at ``--phi`` in the 16.875 h box
 of ``make_shape_seeds.py`` (strain 1 + 4), then the same packing in seed 000's Papanastasiou
 matrix (μ_0/μ_pl = 99) at x = Mγ̇ = ``--x``, the law scaled so μ_m(γ̇) = 1
 (``stages.bingham_suspension.matrix_law``); prints η/μ_m(γ̇), the estimate η_COT = g μ_m(γ̇
 sqrt(g/(1 − φ))) and their ratio. ``--friction`` sets ``inclusions.lubrication.friction``
-for both runs. One thread per run; writes nothing.
+and each ``--set`` its scene key for both runs. One thread per run; writes nothing.
 """
 import argparse
 
 from suspsim.rheology.laws import make_law
 from suspsim.rheology.suspension import chateau_ovarlez_trung_viscosity
 from suspsim.stages.bingham_suspension import matrix_law
-from suspsim.validation.suspension import RATE, relative_viscosity
+from suspsim.validation.suspension import (RATE, add_run_options, overrides_text,
+                                           parse_overrides, relative_viscosity)
 
 BOX = 16.875
 RADIUS = 2.5
@@ -27,15 +29,19 @@ def main() -> None:
     parser.add_argument("--x", type=float, default=1.0)
     parser.add_argument("--phi", type=float, default=0.4)
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
+    add_run_options(parser, example=", e.g. numerics.spin_correction=true")
     args = parser.parse_args()
-    friction = {"inclusions.lubrication.friction": args.friction}
+    transient, units = args.strain[0], int(args.strain[1])
+    newtonian = {"inclusions.lubrication.friction": args.friction, **parse_overrides(args.set)}
+    print(f"φ = {args.phi}, box {BOX} h, a = {RADIUS} h, strain {transient:g} + {units}"
+          f"{overrides_text(newtonian)}", flush=True)
     name, params = matrix_law(args.x, 99.0, RATE)
     law = make_law(name, params)
-    matrix = {**friction, "fluid": {"law": name, "params": dict(params)}}
+    matrix = {**newtonian, "fluid": {"law": name, "params": dict(params)}}
     for seed in args.seeds:
-        g = relative_viscosity(phi=args.phi, radius=RADIUS, box=BOX, seed=seed,
-                               overrides=friction)
-        m = relative_viscosity(phi=args.phi, radius=RADIUS, box=BOX, seed=seed, overrides=matrix)
+        g, m = (relative_viscosity(phi=args.phi, radius=RADIUS, box=BOX, seed=seed,
+                                   transient=transient, units=units, overrides=overrides)
+                for overrides in (newtonian, matrix))
         cot = float(chateau_ovarlez_trung_viscosity(law.viscosity, RATE, args.phi,
                                                     g.relative_viscosity))
         print(f"friction {args.friction:g}, x {args.x:g}, seed {seed}: g "

@@ -109,10 +109,6 @@ def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, newt
     auto → fluid_mean where shifting acts (A > 0 and γ_s > 0), nominal elsewhere; an explicit fluid_mean where it
     does not is refused (particles pair up, SPEC §2.3)."""
     out = dict(numerics)
-    if numerics["spin_correction"] and not newtonian and numerics["bulk_correction"]:
-        fail(("numerics", "spin_correction"), "needs a Newtonian matrix: the variable-viscosity "
-             "term of the bulk correction (SPEC §2.4) is derived for the uncorrected pair form; "
-             "set spin_correction: false, or bulk_correction: false")
     if numerics["shifting"] == "auto":
         with_inclusions = (AUTO_SHIFTING_WITH_INCLUSIONS if newtonian
                            else AUTO_SHIFTING_NON_NEWTONIAN)

@@ -87,9 +87,9 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     entry); a Newtonian fluid runs the gradient and normalisation passes only on the steps
     :func:`~suspsim.sph.terms.velocity_pass.normalisation_due` picks from
     ``normalisation_interval`` and ``normalisation_age`` and holds μ̂ in between;
-    ``bulk_gradient`` the ∇a sums (B on and μ varying). ``has_bodies``: the scene has rigid
-    bodies (angular velocities ``body_spin`` (B, 3), for ``terms.viscous.spin_free_velocity``;
-    a (1, 3) array of zeros without bodies), whose particles (``body_of`` (N,) ≥ 0; −1 for
+    ``bulk_gradient`` the ∇a sums (B on, μ varying, no spin correction). ``has_bodies``: the
+    scene has rigid bodies (angular velocities ``body_spin`` (B, 3), for
+    ``terms.viscous.spin_free_velocity``; a (1, 3) array of zeros without bodies), whose particles (``body_of`` (N,) ≥ 0; −1 for
     fluid) have no pairs inside their own body in the list (``group`` of
     ``neighbours.build_neighbour_list``) and take their density and μ̂ from the fluid around
     them (``density.body_particle_density``); their gradient, rate and inverse moment are 0

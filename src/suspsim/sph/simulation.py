@@ -106,8 +106,10 @@ class Simulation:
         self._law = law
         self._newtonian = bool(law.is_newtonian)
         self._normalise = bool(scene.numerics.viscous_normalisation)
-        self._bulk_gradient = bool(scene.numerics.bulk_correction) and not self._newtonian
         self._spin_correction = bool(scene.numerics.spin_correction)
+        # the spin-corrected pair sum is already the divergence of its stress (viscous.local_spin)
+        self._bulk_gradient = (bool(scene.numerics.bulk_correction) and not self._newtonian
+                               and not self._spin_correction)
         self._velocity_gradient = (not self._newtonian) or self._normalise or self._spin_correction
         self._alpha, self._beta = viscous_weights(scene.dimension, scene.numerics.bulk_correction,
                                                   self._spin_correction)
