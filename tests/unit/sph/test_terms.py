@@ -202,3 +202,26 @@ def test_spin_correction_removes_the_viscous_force_of_rigid_rotation():
     np.testing.assert_allclose(scale, scale[0], rtol=1e-12)
     np.testing.assert_allclose(_two_particle_force([-1, -1], [1.0, 1.0], straining),
                                scale[0] * plain, rtol=1e-12)
+
+
+def test_spin_corrected_fluid_body_pair_takes_the_mean_spin():
+    """With ``numerics.spin_correction`` a fluid–body pair takes v relative to the mean of the
+    fluid particle's ½ ∇×v and the body's Ω (``viscous.particle_spin``): none if the fluid
+    turns rigidly with the body; a fluid particle at rest in a turning body's neighbourhood
+    gets half the body's rotation taken out, as a fluid pair of spins Ω and 0 would."""
+    omega = np.array([0.3, -0.7, 1.1])
+    rigid = (np.cross(omega, PAIR_SEPARATION), (0.0, 0.0, 0.0))
+    turning = np.tile(_rotation_gradient(omega), (2, 1))
+    for body_of in ([-1, 0], [0, -1]):
+        np.testing.assert_allclose(
+            _two_particle_force(body_of, [1.0, 1.0], rigid, [omega], gradient=turning), 0.0,
+            atol=1e-15)
+    still = np.zeros((2, 9))
+    half = [turning[0], still[0]]
+    fluid_pair = _two_particle_force([-1, -1], [1.0, 1.0], rigid, gradient=half)
+    np.testing.assert_allclose(
+        _two_particle_force([-1, 0], [1.0, 1.0], rigid, [0.0 * omega], gradient=half),
+        fluid_pair, rtol=1e-12)
+    np.testing.assert_allclose(
+        _two_particle_force([-1, 0], [1.0, 1.0], rigid, [omega], gradient=still),
+        fluid_pair, rtol=1e-12)

@@ -18,11 +18,11 @@ term of a rotating body would give a spurious torque. The simulation's list does
 them (``group`` of ``neighbours.build_neighbour_list``); the loop also skips them, for tables
 built without groups. For the same reason a pair with a body particle takes v relative to the
 body's rigid rotation, v − Ω_B × r (``viscous.spin_free_velocity``; Ω_B from ``body_spin``),
-and with ``numerics.spin_correction`` a fluid–fluid pair takes v relative to the mean of the
-two particles' local spin ½ ∇×v (``viscous.local_spin``), which makes the stress symmetric.
-With the
-bulk correction and a varying viscosity the pass also sums Σ_j V_j F (a_i − a_j) r_ij for
-∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
+and with ``numerics.spin_correction`` every pair takes v relative to the mean of its two
+particles' spins (``viscous.particle_spin``: ½ ∇×v of a fluid particle, Ω_B of a body's), which
+makes the stress symmetric. With the bulk correction and a varying viscosity (and no spin
+correction, whose pair sum needs no explicit term) the pass also sums Σ_j V_j F (a_i − a_j) r_ij
+for ∇a = M2⁻¹ Σ_j V_j F (a_i − a_j) r_ij (moment-corrected, as the velocity gradient), whose
 explicit term ½ ∂_i a ∇·v − ½ ∂_k a ∂_i v_k is added per particle afterwards; it has no pair
 form and is left out of the virial (it vanishes in simple shear and plane Poiseuille).
 
@@ -54,7 +54,7 @@ from numba import njit, prange
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.terms.pressure import pressure_pair, pressure_term
-from suspsim.sph.terms.viscous import (explicit_bulk_term, local_spin, pair_viscosity,
+from suspsim.sph.terms.viscous import (explicit_bulk_term, pair_viscosity, particle_spin,
                                       spin_free_velocity, viscous_pair, without_rotation)
 
 
@@ -88,8 +88,8 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
         body_i = body_of[i]
         vxi, vyi, vzi = velocity[i, 0], velocity[i, 1], velocity[i, 2]
         oxi = oyi = ozi = 0.0
-        if spin_correction and body_i < 0:
-            oxi, oyi, ozi = local_spin(gradient[i])
+        if spin_correction:
+            oxi, oyi, ozi = particle_spin(body_spin, body_i, gradient[i])
         fxi = fyi = fzi = 0.0
         gxi = gyi = gzi = 0.0
         cxi = cyi = czi = 0.0
@@ -111,17 +111,17 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
             kp = pressure_pair(p_i, pressure[j], f)
             mu_a, mu_b = mu_i, viscosity[j]
             body_j = body_of[j]
-            if body_i >= 0 or body_j >= 0:
-                vx, vy, vz = spin_free_velocity(body_spin, body_i, body_j, dx, dy, dz,
-                                                vx, vy, vz)
-                if body_i < 0:
-                    mu_b = mu_a
-                elif body_j < 0:
-                    mu_a = mu_b
-            elif spin_correction:
-                oxj, oyj, ozj = local_spin(gradient[j])
+            if spin_correction:
+                oxj, oyj, ozj = particle_spin(body_spin, body_j, gradient[j])
                 vx, vy, vz = without_rotation(0.5 * (oxi + oxj), 0.5 * (oyi + oyj),
                                               0.5 * (ozi + ozj), dx, dy, dz, vx, vy, vz)
+            elif body_i >= 0 or body_j >= 0:
+                vx, vy, vz = spin_free_velocity(body_spin, body_i, body_j, dx, dy, dz,
+                                                vx, vy, vz)
+            if body_i < 0 <= body_j:
+                mu_b = mu_a
+            elif body_j < 0 <= body_i:
+                mu_a = mu_b
             wx, wy, wz = viscous_pair(pair_viscosity(mu_a, mu_b), f * vol_i * vol_j,
                                       dx, dy, dz, r2, vx, vy, vz, alpha, beta)
             fx = kp * dx + wx
