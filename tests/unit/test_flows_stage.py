@@ -90,8 +90,8 @@ def test_channel_law_has_its_bingham_number_reynolds_number_and_seed_ratio(bingh
 
 def test_bingham_10_channel_is_the_validation_run_and_bn_0_the_newtonian_parabola():
     _, params, _, _ = channel_law({**BLOCK, "bingham": 10.0})
-    # tests/validation/test_sph_flows.py bingham_law(16): mu_pl = 78.125, mu_0 = 99 mu_pl,
-    # M = 100 (W = 15 h; there Re follows from M, here M from Re = 2.28).
+    # suspsim.validation.flows.bingham_law(16), the 2D validation channel: mu_pl = 78.125,
+    # mu_0 = 99 mu_pl, M = 100 (W = 15 h; there Re follows from M, here M from Re = 2.28).
     assert params["mu_pl"] == pytest.approx(78.125)
     assert params["M"] == pytest.approx(100.0, rel=1e-3)
     name, params, force, newtonian = channel_law({**BLOCK, "bingham": 0.0})

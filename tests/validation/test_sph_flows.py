@@ -23,20 +23,17 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "unit" / "sph"))
 from sph_helpers import couette_scene, measured_viscosity_ratio  # noqa: E402
 
-from suspsim.reference.poiseuille import (force_density_for_bingham,  # noqa: E402
-                                          poiseuille_profile)
+from suspsim.reference.poiseuille import poiseuille_profile  # noqa: E402
 from suspsim.rheology.laws import make_law  # noqa: E402
-from suspsim.scene import scene_from_dict  # noqa: E402
-from suspsim.sph.simulation import Simulation  # noqa: E402
-from suspsim.validation.flows import (poiseuille_profile_error,  # noqa: E402
-                                      start_from_newtonian_profile)
+from suspsim.validation.flows import (DENSITY_2D_POISEUILLE, DENSITY_3D,  # noqa: E402
+                                      bingham_channel_error, channel_error,
+                                      newtonian_channel_error)
 from suspsim.validation.startup import papanastasiou_startup, profile_error  # noqa: E402
 
 pytestmark = pytest.mark.slow
 REDUCED = os.environ.get("SUSPSIM_REDUCED") == "1"
 RE_PARTICLE = 0.1
-DENSITY_3D, DENSITY_2D = 4.096, 6.25
-DENSITY_2D_POISEUILLE = 16.0
+DENSITY_2D = 6.25
 #: CI's two cores.
 THREADS = 2
 
@@ -90,62 +87,17 @@ def test_papanastasiou_startup_matches_the_1d_reference():
     assert float(errors.max()) < 0.025, errors.values
 
 
-def poiseuille_error(law, params, g, dim, density, height, t_run, t_avg, *, lateral=None,
-                     newtonian_start=False):
-    """L2 error relative to the peak of the profile averaged over the last ``t_avg`` of
-    ``t_run`` against SPEC §6.2 (``validation.flows.poiseuille_profile_error``: one bin per
-    lattice row). ``lateral`` box side along x (and z) [h]; default 5 in 3D, 8 in 2D.
-    ``newtonian_start``: start from the Newtonian profile with the reference's flow rate
-    instead of rest (the shape then settles in the yielded layers' diffusion time, not the
-    flow rate in the whole channel's)."""
-    lateral = lateral or (5.0 if dim == 3 else 8.0)
-    box = [lateral, height, lateral] if dim == 3 else [lateral, height]
-    scene = scene_from_dict({"dimension": dim, "box": box, "number_density": density,
-                             "fluid": {"law": law, "params": params},
-                             "flow": {"type": "poiseuille", "body_force": g},
-                             "run": {"time": t_run}, "lattice": {"jitter": 0.1}})
-    sim = Simulation(scene, threads=THREADS)
-    if newtonian_start:
-        sim = start_from_newtonian_profile(sim)
-    return poiseuille_profile_error(sim, run_time=t_run, averaging=t_avg).value
-
-
 @pytest.mark.parametrize("dim, density", [(3, DENSITY_3D), (2, DENSITY_2D_POISEUILLE)])
 def test_newtonian_poiseuille_profile(dim, density):
     """Re = ρ u_max W/μ ≈ 0.1 (μ = 1.25 ρ at g = 0.01, W = 5). At Re ≈ 40 the disordered
     lattice loses 10 % of the flow; in 2D at n = 6.25 the error is 5.6 % (open)."""
-    height, g = 10.0, 0.01
-    mu = 1.25 * density
-    t_visc = density * (height / 2) ** 2 / mu
-    error = poiseuille_error("newtonian", {"mu": mu}, g, dim, density, height, 3 * t_visc,
-                             t_visc)
-    assert error < 0.03
-
-
-def bingham_law(density):
-    """Seed 000's Papanastasiou law with μ_pl = 20 per unit of 3D density 4.096 (so a 2D run at
-    n = 16 is the same dimensionless problem: equal ρ/μ_pl, time step and Reynolds number)."""
-    mu_pl = 20.0 * density / DENSITY_3D
-    return {"mu_pl": mu_pl, "mu_0": 99.0 * mu_pl, "M": 100.0}
-
-
-def bingham_poiseuille_error(bingham, dim, height, t_run, t_avg, lateral=None,
-                             newtonian_start=False):
-    """Split-force Poiseuille of :func:`bingham_law` at Bingham number ``bingham`` (defined
-    in ``reference.poiseuille``) in channels of width W = height/2; ``t_run``, ``t_avg`` [τ]
-    (the viscous time of a 5 h channel is t_visc = ρ (5 h)²/μ_pl = 5.12 τ)."""
-    density = DENSITY_3D if dim == 3 else DENSITY_2D_POISEUILLE
-    params = bingham_law(density)
-    law = make_law("papanastasiou", params)
-    force = force_density_for_bingham(law, height / 2, bingham)
-    return poiseuille_error("papanastasiou", params, force / density, dim, density, height,
-                            t_run, t_avg, lateral=lateral, newtonian_start=newtonian_start)
+    assert newtonian_channel_error(dim, density, threads=THREADS) < 0.03
 
 
 def test_bingham_1_poiseuille_profile():
     """Papanastasiou (seed 000: μ_0/μ_pl = 99, M = 100) at Bn = 1 in split-force Poiseuille,
     W = 5 h, averaged over 0.2 t_visc after 0.6 t_visc."""
-    error = bingham_poiseuille_error(1.0, 3, 10.0, 0.8 * 5.12, 0.2 * 5.12)
+    error = bingham_channel_error(1.0, 3, 10.0, 0.8 * 5.12, 0.2 * 5.12)
     assert error < 0.03
 
 
@@ -161,12 +113,12 @@ def test_bingham_10_poiseuille_profile_3d():
     Reduced (CI): the convergence itself — W = 5 h and 10 h, the error must fall by at least
     4× (measured 7×); the 3 % bound is checked at full size."""
     if REDUCED:
-        coarse = bingham_poiseuille_error(10.0, 3, 10.0, 0.8 * 5.12, 0.2 * 5.12)
-        fine = bingham_poiseuille_error(10.0, 3, 20.0, 12.0, 4.0, lateral=3.75,
+        coarse = bingham_channel_error(10.0, 3, 10.0, 0.8 * 5.12, 0.2 * 5.12)
+        fine = bingham_channel_error(10.0, 3, 20.0, 12.0, 4.0, lateral=3.75,
                                         newtonian_start=True)
         assert fine < coarse / 4, (coarse, fine)
     else:
-        error = bingham_poiseuille_error(10.0, 3, 60.0, 45.0, 15.0, lateral=3.75,
+        error = bingham_channel_error(10.0, 3, 60.0, 45.0, 15.0, lateral=3.75,
                                          newtonian_start=True)
         assert error < 0.03
 
@@ -174,7 +126,7 @@ def test_bingham_10_poiseuille_profile_3d():
 def test_bingham_1_poiseuille_2d():
     """2D version of Bn = 1 at n = 16 per h², W = 5 h: measured 1.3 % (box 8 h or 3.75 h
     across; 42 s or 20 s on one thread)."""
-    error = bingham_poiseuille_error(1.0, 2, 10.0, 0.8 * 5.12, 0.2 * 5.12,
+    error = bingham_channel_error(1.0, 2, 10.0, 0.8 * 5.12, 0.2 * 5.12,
                                      lateral=3.75 if REDUCED else 8.0)
     assert error < 0.03
 
@@ -189,7 +141,7 @@ def test_bingham_10_poiseuille_2d():
     rate at the force-reversal plane (a cusp of |γ̇|, smoothed over h) is too low, hence the
     viscosity too high and the yielded layer 13 % slow near the plane. 2D at n = 16 has no
     visible lattice oscillation, unlike 3D at n = 4.096."""
-    error = bingham_poiseuille_error(10.0, 2, 30.0, 18.0, 4.0, lateral=3.75)
+    error = bingham_channel_error(10.0, 2, 30.0, 18.0, 4.0, lateral=3.75)
     assert error < 0.03
 
 
@@ -220,7 +172,7 @@ def test_carreau_yasuda_poiseuille_profile():
     mu_0 = density * u_max * 2 * half / (RE_CHANNEL * mu_wall_per_mu0)
     t_diff = density * half ** 2 / (mu_wall_per_mu0 * mu_0)
     t_avg = 4 * density ** (-1 / 3) / u_max
-    error = poiseuille_error("carreau_yasuda", {"mu_0": mu_0, **CARREAU_YASUDA},
+    error = channel_error("carreau_yasuda", {"mu_0": mu_0, **CARREAU_YASUDA},
                              force_per_mu0 * mu_0 / density, 3, density, height,
                              4 * t_diff + t_avg, t_avg, lateral=3.75)
     assert error < 0.03

@@ -158,7 +158,8 @@ def check(case_name: str, tolerance: float, *, max_runs: int = MAX_COMPARISONS,
                     attempts=n, expected_error=float(expected),
                     picked_error_bound=float(bound[n - 1]), picked_cpu_time=float(cpu[n - 1]),
                     paid_cpu_time=paid, cheapest_meeting_cpu_time=cheapest, cost_ratio=ratio,
-                    passed=int(passed), retimed=int(retimed), error_model=json.dumps(model.provenance), **scale)
+                    passed=int(passed), retimed=int(retimed),
+                    error_model=json.dumps(model.provenance), **scale)
     log.info("%s at %g (%s): %d run(s), answer bound %.4g (expected %.4g), paid %.3g s CPU, "
              "cheapest meeting %.3g s, ratio %.2f: %s", case_name, tolerance, ds.attrs["mode"],
              n, bound[n - 1], expected, paid, cheapest, ratio, "pass" if passed else "FAIL")

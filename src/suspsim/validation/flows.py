@@ -22,13 +22,16 @@ from typing import Any, Callable
 import numpy as np
 
 from suspsim.errors import NumericalError
-from suspsim.reference.poiseuille import split_force_poiseuille_profile
+from suspsim.reference.poiseuille import force_density_for_bingham, split_force_poiseuille_profile
 from suspsim.rheology.laws import make_law
 
 #: Stress samples per strain unit in a Couette reading [choice: resolves the lattice ripple].
 SAMPLES_PER_UNIT = 50
 #: Profile samples over the averaging window of a Poiseuille reading [choice].
 PROFILE_SAMPLES = 40
+#: Number densities of the validation channels [h^-d]: 3D 4.096 (a 16-cube lattice per 10 h),
+#: 2D 16 (at 6.25 the Newtonian profile is 5.6 % off; ``tests/validation/test_sph_flows.py``).
+DENSITY_3D, DENSITY_2D_POISEUILLE = 4.096, 16.0
 
 
 @dataclass(frozen=True)
@@ -139,3 +142,60 @@ def start_from_newtonian_profile(sim, *, threads: int | None = None):
     state["velocities"][:, 0] = scale * split_force_poiseuille_profile(
         newtonian, force_density, height, state["positions"][:, 1])
     return Simulation.from_state(scene, state, threads=threads or sim.threads)
+
+
+def channel_error(law: str, params: dict, g: float, dim: int, density: float, height: float,
+                  t_run: float, t_avg: float, *, lateral: float | None = None,
+                  newtonian_start: bool = False, numerics: dict | None = None,
+                  threads: int = 2) -> float:
+    """L2/peak error [1] of the split-force Poiseuille profile of ``law`` (``params``) at body
+    acceleration ``g`` [h τ⁻²], averaged over the last ``t_avg`` of ``t_run`` [τ]
+    (:func:`poiseuille_profile_error`), in a box ``height`` [h] high (two channels of width
+    height/2) and ``lateral`` [h] across (default 5 in 3D, 8 in 2D) at ``density`` [h^-d],
+    from a lattice jittered by 0.1 spacing. ``newtonian_start``: from the Newtonian profile
+    of the reference's flow rate (:func:`start_from_newtonian_profile`) instead of rest;
+    ``numerics``: scene keys of the ``numerics`` block."""
+    from suspsim.scene import scene_from_dict
+    from suspsim.sph.simulation import Simulation
+
+    lateral = lateral or (5.0 if dim == 3 else 8.0)
+    box = [lateral, height, lateral] if dim == 3 else [lateral, height]
+    scene = scene_from_dict({"dimension": dim, "box": box, "number_density": density,
+                             "fluid": {"law": law, "params": params},
+                             "flow": {"type": "poiseuille", "body_force": g},
+                             "run": {"time": t_run}, "lattice": {"jitter": 0.1},
+                             "numerics": dict(numerics or {})})
+    sim = Simulation(scene, threads=threads)
+    if newtonian_start:
+        sim = start_from_newtonian_profile(sim)
+    return poiseuille_profile_error(sim, run_time=t_run, averaging=t_avg).value
+
+
+def newtonian_channel_error(dim: int, density: float, **kwargs) -> float:
+    """:func:`channel_error` of the Newtonian channel of the validation tests: W = 5 h,
+    g = 0.01 h τ⁻², μ = 1.25 ρ (Re = ρ u_max W/μ ≈ 0.1), three viscous times ρ W²/μ, the last
+    one averaged."""
+    height, g = 10.0, 0.01
+    mu = 1.25 * density
+    t_visc = density * (height / 2) ** 2 / mu
+    return channel_error("newtonian", {"mu": mu}, g, dim, density, height, 3 * t_visc, t_visc,
+                         **kwargs)
+
+
+def bingham_law(density: float) -> dict[str, float]:
+    """Seed 000's Papanastasiou law with μ_pl = 20 per unit of 3D density 4.096 (so a 2D run at
+    n = 16 is the same dimensionless problem: equal ρ/μ_pl, time step and Reynolds number)."""
+    mu_pl = 20.0 * density / DENSITY_3D
+    return {"mu_pl": mu_pl, "mu_0": 99.0 * mu_pl, "M": 100.0}
+
+
+def bingham_channel_error(bingham: float, dim: int, height: float, t_run: float, t_avg: float,
+                          **kwargs) -> float:
+    """:func:`channel_error` of :func:`bingham_law` at Bingham number ``bingham`` (defined in
+    ``reference.poiseuille``) in channels of width W = height/2 [h]; ``t_run``, ``t_avg`` [τ]
+    (the viscous time of a 5 h channel is t_visc = ρ (5 h)²/μ_pl = 5.12 τ)."""
+    density = DENSITY_3D if dim == 3 else DENSITY_2D_POISEUILLE
+    params = bingham_law(density)
+    force = force_density_for_bingham(make_law("papanastasiou", params), height / 2, bingham)
+    return channel_error("papanastasiou", params, force / density, dim, density, height, t_run,
+                         t_avg, **kwargs)
