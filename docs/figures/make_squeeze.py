@@ -1,6 +1,7 @@
 """Make docs/figures/squeeze_force.{nc,png}: resolved SPH squeeze force between two spheres.
 
     python docs/figures/make_squeeze.py [--threads N] [--reduced] [--no-large]
+        [--set numerics.KEY=VALUE ...]
     python docs/figures/make_squeeze.py --plot-only    # redraw from the .nc
 
 Runs :func:`suspsim.validation.squeeze.squeeze_study` for a = 2.5 h (box 25 × 20 × 20 h,
@@ -8,9 +9,12 @@ Re = 0.05, and the same at half the speed for the quasi-steady check) and a = 4 
 32 × 25 × 25 h, Re = 0.1; skipped with --no-large), draws them with
 :func:`suspsim.plotting.squeeze.plot_squeeze` and prints the table s, F/F_theory and the
 recommended cutoff gap. --reduced: the test's small case only. The runs are kept in
-``squeeze_force.nc`` (netCDF4 groups, one per run, named by its label).
+``squeeze_force.nc`` (netCDF4 groups, one per run, named by its label). ``--set`` takes
+numerics keys of the runs' scenes (VALUE as JSON, e.g. ``numerics.shifting=100``); such runs
+print their tables and write no file.
 """
 import argparse
+import json
 from pathlib import Path
 
 import xarray as xr
@@ -56,7 +60,16 @@ def main() -> None:
     parser.add_argument("--reduced", action="store_true", help="the test's reduced case")
     parser.add_argument("--no-large", action="store_true", help="skip a = 4 h")
     parser.add_argument("--plot-only", action="store_true", help=f"redraw from {NETCDF.name}")
+    parser.add_argument("--set", action="append", default=[], metavar="numerics.KEY=VALUE",
+                        help="a numerics key of every run (repeatable; nothing is written)")
     args = parser.parse_args()
+    numerics = {}
+    for item in args.set:
+        key, _, value = item.partition("=")
+        if not key.startswith("numerics.") or not value:
+            parser.error(f"--set {item}: give numerics.KEY=VALUE")
+        numerics[key.removeprefix("numerics.")] = json.loads(value)
+    common = {"threads": args.threads, "numerics": numerics or None}
     runs, labels = [], []
     if args.plot_only:
         with xr.open_datatree(NETCDF) as tree:
@@ -65,21 +78,21 @@ def main() -> None:
                 labels.append(node.attrs["label"])
     elif args.reduced:
         runs.append(squeeze_study(2.5, (20.0, 15.0, 15.0), reynolds=0.1, end_gap=0.2,
-                                  threads=args.threads))
+                                  **common))
         labels.append("a = 2.5 h, reduced")
     else:
         box = (25.0, 20.0, 20.0)
-        drag = stokes_drag(2.5, box, reynolds=0.05, threads=args.threads)
+        drag = stokes_drag(2.5, box, reynolds=0.05, **common)
         for reynolds in (0.05, 0.025):
-            runs.append(squeeze_study(2.5, box, reynolds=reynolds, drag=drag,
-                                      threads=args.threads))
+            runs.append(squeeze_study(2.5, box, reynolds=reynolds, drag=drag, **common))
             labels.append(f"a = 2.5 h, Re = {reynolds:g}")
         if not args.no_large:
-            runs.append(squeeze_study(4.0, (32.0, 25.0, 25.0), reynolds=0.1,
-                                      threads=args.threads))
+            runs.append(squeeze_study(4.0, (32.0, 25.0, 25.0), reynolds=0.1, **common))
             labels.append("a = 4 h, Re = 0.1")
     for data, label in zip(runs, labels):
         _table(data, label)
+    if numerics:
+        return
     if not args.plot_only:
         _save(runs, labels)
     save_figure(plot_squeeze(runs, labels=labels), OUTPUT)

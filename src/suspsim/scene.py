@@ -70,6 +70,8 @@ class RunSpec:
     profile_bins: int
     threads: int | None
     max_density_error: float
+    density_outlier_fraction: float
+    max_outlier_density_error: float
     max_mach: float
 
     @property

@@ -142,6 +142,9 @@ BAD = [
     ("zero threads", _edit("  dt: auto", "  threads: 0"), "run.threads", 14, "an integer ≥ 1 or 'all'"),
     ("poiseuille started linear", POISEUILLE_2D.replace("threads: 2", "start: linear"), "run.start", 6,
      "starts from rest"),
+    ("outlier ceiling below the limit", _edit("  dt: auto", "  max_density_error: 0.3\n"
+                                              "  max_outlier_density_error: 0.2"),
+     "run.max_outlier_density_error", 15, "at least the limit"),
 ]
 
 
@@ -234,6 +237,18 @@ def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected)
     assert (fluid.numerics.shifting, fluid.numerics.pressure_reference) == (0.0, "nominal")
     assert suspension.numerics.shifting == expected
     assert suspension.numerics.pressure_reference == "fluid_mean"
+
+
+def test_density_limits_let_outliers_pass_only_with_inclusions(tmp_path):
+    fluid = load_scene(_write(tmp_path, MINIMAL)).run
+    suspension = load_scene(_write(tmp_path, MINIMAL + "inclusions: {phi: 0.1, radius: 2.0}\n")).run
+    assert (fluid.max_density_error, fluid.density_outlier_fraction,
+            fluid.max_outlier_density_error) == (0.05, 0.0, 0.05)
+    assert (suspension.max_density_error, suspension.density_outlier_fraction,
+            suspension.max_outlier_density_error) == (0.3, 1e-3, 0.6)
+    given = load_scene(_write(tmp_path, _edit("  dt: auto", "  max_density_error: 0.1")
+                              + "inclusions: {phi: 0.1, radius: 2.0}\n")).run
+    assert given.max_outlier_density_error == pytest.approx(0.2)
 
 
 def test_smallest_box_side_is_three_cells_of_the_neighbour_list():

@@ -33,7 +33,8 @@ FORMAT = "suspsim-checkpoint"
 FORMAT_VERSION = 2
 #: Scene keys that do not change the physics and may differ when a run resumes.
 RESUMABLE_KEYS = (("run", "threads"), ("run", "checkpoint_interval_s"),
-                  ("run", "max_density_error"), ("run", "max_mach"),
+                  ("run", "max_density_error"), ("run", "density_outlier_fraction"),
+                  ("run", "max_outlier_density_error"), ("run", "max_mach"),
                   ("numerics", "max_density_error"), ("numerics", "max_mach"),
                   ("numerics", "max_viscosity_ratio"))
 _HEADER = "__suspsim_header__"

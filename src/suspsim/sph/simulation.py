@@ -42,6 +42,7 @@ from suspsim.scene import Scene
 from suspsim.sph import kernels
 from suspsim.sph.boundaries import lees_edwards_offset
 from suspsim.sph.density import TABLE_OK, allocate_pair_table, pair_capacity
+from suspsim.sph.health import density_verdict
 from suspsim.sph.integrator import (GROW_TABLE, REBUILD, accelerations, advance_steps, drift,
                                     kick, predict)
 from suspsim.sph.lattice import imposed_velocity, initial_velocities, lattice_positions
@@ -601,10 +602,14 @@ class Simulation:
         n_fluid = self.n_particles - self._members.shape[0]
         return float((np.sum(self._rho) - np.sum(self._rho[self._members])) / n_fluid)
 
-    def _density_error(self) -> float:
-        """max |ρ/ρ_eq − 1| over the fluid particles (a rigid body's particles cannot follow)."""
+    def _density_errors(self) -> np.ndarray:
+        """|ρ/ρ_eq − 1| of each fluid particle [1] (a rigid body's particles cannot follow)."""
         rho = self._rho if self.bodies is None else self._rho[self._body_of < 0]
-        return float(np.max(np.abs(rho / self._rho_eq - 1.0)))
+        return np.abs(rho / self._rho_eq - 1.0)
+
+    def _density_error(self) -> float:
+        """max |ρ/ρ_eq − 1| over the fluid particles [1]."""
+        return float(np.max(self._density_errors()))
 
     def _mach(self) -> float:
         peculiar = self._peculiar()
@@ -620,11 +625,13 @@ class Simulation:
                 and np.all(np.isfinite(self._a)) and np.all(np.isfinite(self._rho))):
             return False, (f"non-finite positions or velocities {where}: the run blew up; lower "
                            f"run.dt or raise run.sound_speed ({settings})")
-        error = self._density_error()
-        if error > run.max_density_error:
-            return False, (f"density error {error:.3g} exceeds run.max_density_error "
-                           f"{run.max_density_error:g} {where}: raise run.sound_speed or lower "
-                           f"run.dt ({settings})")
+        errors = self._density_errors()
+        error = float(np.max(errors))
+        density = density_verdict(errors, run.max_density_error, run.density_outlier_fraction,
+                                  run.max_outlier_density_error)
+        if density:
+            return False, (f"{density} {where}: raise run.sound_speed or lower run.dt "
+                           f"({settings})")
         if self._lubrication is not None and (self._lubrication_stats[OVERLAPS] > 0
                                               or self._lubrication_stats[SMALLEST_GAP] < 0):
             return False, (f"bodies overlap {where} (smallest gap "

@@ -277,7 +277,7 @@ def squeeze_theory(gap, radius: float, viscosity: float, speed: float, box=None)
 
 # ---------------------------------------------------------------- SPH runs
 def _two_sphere_scene(box, radius, centres, viscosity, sound_speed, workdir, *,
-                      number_density=4.096, shifting_rate=0.0):
+                      number_density=4.096, shifting_rate=0.0, numerics=None):
     from suspsim.bodies.packing import Packing
     from suspsim.io.packing_file import write_packing
     from suspsim.scene import scene_from_dict
@@ -297,7 +297,8 @@ def _two_sphere_scene(box, radius, centres, viscosity, sound_speed, workdir, *,
         # No imposed shear: shifting takes the bodies' own rate U/a (SHIFTING_COEFFICIENT).
         "numerics": {"shifting": SHIFTING_COEFFICIENT if shifting_rate > 0 else 0.0,
                      "shifting_rate": float(shifting_rate),
-                     "pressure_reference": "fluid_mean" if shifting_rate > 0 else "nominal"},
+                     "pressure_reference": "fluid_mean" if shifting_rate > 0 else "nominal",
+                     **(numerics or {})},
         "inclusions": {"packing": str(path)}})
 
 
@@ -308,8 +309,10 @@ def _speed(radius, viscosity, reynolds, number_density):
 def squeeze_run(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float = 1.0,
                 reynolds: float = REYNOLDS, start_gap: float | None = None,
                 end_gap: float = 0.05, sound_speed: float = SOUND_SPEED,
-                number_density: float = 4.096, threads: int = 1) -> dict:
-    """Raw time series of the prescribed approach (module docstring).
+                number_density: float = 4.096, threads: int = 1,
+                numerics: dict | None = None) -> dict:
+    """Raw time series of the prescribed approach (module docstring); ``numerics`` scene
+    keys over the runs' own (e.g. ``{"spin_correction": True}``).
 
     The speed of each sphere is U = Re μ/(ρ_f a). ``start_gap`` default 2a + 2 h. Returns a
     dict of arrays ``gap`` (nominal, [h]) and ``force`` (squeeze force, [m h τ⁻²]) per step,
@@ -327,7 +330,7 @@ def squeeze_run(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float
     with tempfile.TemporaryDirectory() as workdir:
         scene = _two_sphere_scene(box, radius, centres, viscosity, sound_speed, workdir,
                                   number_density=number_density,
-                                  shifting_rate=speed / radius)
+                                  shifting_rate=speed / radius, numerics=numerics)
         sim = Simulation(scene, threads=threads)
     motion = np.array([[speed, 0.0, 0.0], [-speed, 0.0, 0.0]])
     still = np.zeros((2, 3))
@@ -350,7 +353,7 @@ def squeeze_run(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float
 def stokes_drag(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float = 1.0,
                 reynolds: float = REYNOLDS, time: float | None = None,
                 sound_speed: float = SOUND_SPEED, number_density: float = 4.096,
-                threads: int = 1) -> dict:
+                threads: int = 1, numerics: dict | None = None) -> dict:
     """Single-sphere drag at speed U relative to the mean fluid velocity (module docstring);
     F averaged over the last third of ``time`` [τ] (default 6 ρ_f L_x²/(4π²μ), six decay
     times of the box's slowest viscous mode). Returns drag, its standard error over 10 blocks,
@@ -366,7 +369,7 @@ def stokes_drag(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float
     with tempfile.TemporaryDirectory() as workdir:
         scene = _two_sphere_scene(box, radius, [box / 2.0], viscosity, sound_speed, workdir,
                                   number_density=number_density,
-                                  shifting_rate=speed / radius)
+                                  shifting_rate=speed / radius, numerics=numerics)
         sim = Simulation(scene, threads=threads)
     fluid_mass = (sim.n_particles - sim.n_body_particles) * scene.mass
     momentum = 0.0
@@ -481,7 +484,7 @@ def squeeze_study(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, reynolds: floa
     """Single-sphere calibration plus the approach run, as one Dataset (module docstring)."""
     if drag is None:
         drag = stokes_drag(radius, box, viscosity=viscosity, reynolds=reynolds,
-                           threads=threads)
+                           threads=threads, numerics=kwargs.get("numerics"))
     run = squeeze_run(radius, box, viscosity=viscosity, reynolds=reynolds, threads=threads,
                       end_gap=end_gap, **kwargs)
     run["reynolds"] = reynolds
