@@ -132,8 +132,9 @@ def test_torque_free_sphere_turns_with_the_fluid():
     """A torque-free sphere in simple shear turns at Ω = −γ̇/2 (Stokes; its images at φ = 0.03
     change that by O(φ)): with ``numerics.spin_correction`` the mean Ω_z over the samples is
     within 3 % of it. Measured (one sphere, a = 2.5 h, 12.5 h box, strain 1 + 2, 2026-12-06):
-    1.001 × γ̇/2 (0.995 before fluid–body pairs took the mean spin); without the correction
-    1.26 (``docs/figures/make_sphere_spin.py``)."""
+    1.014 × γ̇/2 (1.001 before the correction's bulk viscosity went through the pressure, 0.995
+    before fluid–body pairs took the mean spin; 0.866 with numerics.shifting 100); without the
+    correction 1.26 (``docs/figures/make_sphere_spin.py``)."""
     sc = suspension_scene(phi=0.03, radius=2.5, box=12.5, seed=1, strain=3.0,
                           overrides=SPIN_CORRECTION)
     spins = [sim.bodies.angular_velocities()[0, 2] / (0.5 * RATE)
@@ -147,11 +148,12 @@ def test_spin_corrected_spheres_inside_published_envelope(phi):
     """With ``numerics.spin_correction``, frictionless Newtonian spheres a = 2.5 h in a 15 h
     box (strain 1 + 4): the mean η_r of packing seeds 1 and 2 (seed 1 alone at CI size) inside
     the min–max of the experimental fits (REFERENCE_NUMBERS §2a), where the uncorrected form
-    reads 5–25 % below it. Measured (2026-12-06, fluid–body pairs relative to the mean spin,
-    ``terms.viscous.particle_spin``): φ = 0.1: 1.339 ± 0.006, 1.303 ± 0.005 against
-    1.316–1.435 (Batchelor & Green 1.302); φ = 0.2: 1.970 ± 0.051, 1.981 ± 0.039 against
-    1.851–2.232; φ = 0.3: 3.39 ± 0.35, 2.94 ± 0.04 against 2.90–3.93. (Before that fix 3–5 %
-    higher: 1.358, 1.320; 2.073, 2.068; 3.58, 3.13.)"""
+    reads 5–25 % below it. Measured (2026-12-06, the correction's bulk viscosity removed,
+    ``terms.viscous.spin_bulk_pressure``): φ = 0.1: 1.337 ± 0.005, 1.310 ± 0.007 against
+    1.316–1.435 (Batchelor & Green 1.302); φ = 0.2: 1.995 ± 0.052, 1.991 ± 0.030 against
+    1.851–2.232; φ = 0.3: 3.45 ± 0.32, 2.95 ± 0.07 against 2.90–3.93. (With it: 1.339, 1.303;
+    1.970, 1.981; 3.39, 2.94; before fluid–body pairs took the mean spin,
+    ``terms.viscous.particle_spin``, 3–5 % higher: 1.358, 1.320; 2.073, 2.068; 3.58, 3.13.)"""
     seeds = (1,) if REDUCED else (1, 2)
     readings = [relative_viscosity(phi=phi, radius=2.5, box=15.0, seed=seed, transient=1.0,
                                    units=4, overrides=SPIN_CORRECTION)

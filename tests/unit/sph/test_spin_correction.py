@@ -7,6 +7,7 @@ from sph_helpers import (constant, couette_scene, evaluate, interior, relaxed_si
                          shear_squared)
 from suspsim.sph.simulation import Simulation
 from suspsim.sph.terms.force_pass import VXY, VYX
+from suspsim.sph.terms.viscous import spin_bulk_ratio
 from suspsim.sph.timestep import viscous_stiffness
 
 RATE = 0.05
@@ -59,9 +60,11 @@ def test_the_corrected_operator_keeps_mu_laplacian():
 def _variable_viscosity_error(dim, number_density, spin):
     """Relative error of the normalised viscous force density on a lattice for the linear
     fields v = ξ G and μ = 1 + c·ξ (random G with divergence and rotation, |∇μ| ≈ 0.1 h⁻¹)
-    against the continuum ∇·σ = (G + Gᵀ)ᵀ c + λ tr G c, σ = μ(∇v + ∇vᵀ) + λ(∇·v) I:
-    λ = (d − 2)μ/(2d) corrected (no explicit term, ``terms.viscous.local_spin``), −2μ/d
-    uncorrected with the explicit ∇a term (SPEC §2.3–2.4)."""
+    against the continuum ∇·σ = (G + Gᵀ)ᵀ c + λ tr G c, σ = μ(∇v + ∇vᵀ) + λ(∇·v) I with
+    λ = −2μ/d, zero bulk viscosity: uncorrected with the explicit ∇a term (SPEC §2.3–2.4),
+    corrected without it (``terms.viscous.local_spin``) and with its bulk viscosity
+    (d + 2)μ/(2d) taken out through the pressure (``terms.viscous.spin_bulk_pressure``; the
+    sound speed is 0, so that is all the pressure holds)."""
     rng = np.random.default_rng(3)
     grad = np.zeros((3, 3))
     grad[:dim, :dim] = rng.normal(size=(dim, dim))
@@ -70,7 +73,7 @@ def _variable_viscosity_error(dim, number_density, spin):
     sim = relaxed_simulation(dim, 5.0, number_density, spin=spin)
     xi, force, _, _ = evaluate(sim, lambda x: x @ grad, lambda x: 1.0 + x @ slope,
                                normalise=True, bulk_gradient=not spin)
-    lam = (dim - 2) / (2 * dim) if spin else -2.0 / dim
+    lam = -2.0 / dim
     exact = slope @ (grad + grad.T) + lam * np.trace(grad) * slope
     error = force[interior(sim, xi)] - exact
     return np.linalg.norm(error.mean(axis=0)) / np.linalg.norm(exact)
@@ -85,6 +88,13 @@ def test_variable_viscosity_converges_to_the_divergence_of_the_stress(spin):
     assert errors[0] > errors[1] > errors[2]
     assert errors[2] < 0.02
     assert _variable_viscosity_error(2, 4.0, spin) < 0.005
+
+
+def test_the_removed_bulk_viscosity_is_that_of_the_corrected_stress():
+    """ζ = 2μ/d + (d − 2)μ/(2d) of σ = μ(∇v + ∇vᵀ) + (d − 2)/(2d) μ(∇·v) I."""
+    for dim in (2, 3):
+        assert spin_bulk_ratio(dim) == pytest.approx(2.0 / dim + (dim - 2) / (2.0 * dim))
+    assert spin_bulk_ratio(3) == pytest.approx(5.0 / 6.0)
 
 
 def test_time_step_and_scene_rules():

@@ -55,7 +55,8 @@ from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.chunks import add_chunk_buffers
 from suspsim.sph.terms.pressure import pressure_pair, pressure_term
 from suspsim.sph.terms.viscous import (explicit_bulk_term, pair_viscosity, particle_spin,
-                                      spin_free_velocity, viscous_pair, without_rotation)
+                                      spin_bulk_pressure, spin_free_velocity, viscous_pair,
+                                      without_rotation)
 
 
 def force_width(bulk_gradient: bool, shifting: bool) -> int:
@@ -178,17 +179,22 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
 @njit(parallel=True, **JIT_OPTIONS)
 def force_sums(start, pair_end, pair_j, geometry, pair_cross, pair_image, velocity, rho, volume,
                viscosity, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient, shear_ly,
-               body_of, body_spin, spin_correction, gradient, pressure, acc, scratch, bounds,
-               virial):
+               body_of, body_spin, spin_correction, spin_bulk, gradient, pressure, acc, scratch,
+               bounds, virial):
     """acc (w N,) = pair forces, ∇a sums and ∇C of every particle, w = :func:`force_width`
     (columns beyond the force and, with ``bulk_gradient``, the ∇a sums take ∇C); ``scratch``
     rows of w N; virial (T, 5) per chunk; ``pressure`` (N,) scratch for the particles'
     m² P/ρ²; ``body_of`` (N,) the rigid body of each particle, −1 for fluid; ``body_spin``
     (B, 3) the bodies' angular velocities [τ⁻¹] (:func:`spin_free_velocity`; any (≥ 1, 3)
     array without bodies); ``spin_correction`` takes fluid–fluid pairs' v relative to the
-    mean local spin of the two particles (``viscous.local_spin``) from ``gradient`` (N, 9)."""
+    mean local spin of the two particles (``viscous.local_spin``) from ``gradient`` (N, 9);
+    ``spin_bulk`` ζ/μ of that form, removed through the fluid particles' pressure
+    (``viscous.spin_bulk_pressure``; 0 leaves the pressure alone)."""
     for i in prange(rho.shape[0]):
         pressure[i] = pressure_term(rho[i], rho_eq, c2, mass)
+        if spin_bulk != 0.0 and body_of[i] < 0:
+            pressure[i] += (mass * mass / (rho[i] * rho[i])
+                            * spin_bulk_pressure(viscosity[i], gradient[i], spin_bulk))
     n_chunks = scratch.shape[0] + 1
     width = acc.shape[0] // rho.shape[0]
     if bulk_gradient and width < 6:

@@ -13,7 +13,8 @@ correction: ∇·[μ(∇v + ∇vᵀ)] + ∇(a ∇·v) except for ½ ∂_i a ∇�
 symmetrisation removes and :func:`explicit_bulk_term` adds back per particle [SPEC §2.3,
 derived; zero in simple shear and plane Poiseuille]. With ``numerics.spin_correction``
 (:func:`local_spin`) the pair sum is itself the divergence of a symmetric stress with variable
-μ, and no explicit term is added.
+μ, and no explicit term is added; its bulk viscosity goes through the pressure
+(:func:`spin_bulk_pressure`).
 
 Symbols:
 
@@ -130,7 +131,7 @@ def local_spin(g):
     (L − W) r = E r: the stress μK [(β/d + 2α/(d(d + 2))) E + α/(d(d + 2)) tr E I] is
     symmetric. Its divergence keeps μ ∇²v when β is doubled (α unchanged), so the shear
     viscosity is the same, and the bulk viscosity becomes ζ = 5μ/6 in 3D (μ in 2D) instead of
-    seed 000's 0. Unlike the particle spins of Müller et al. this adds no variable: w is
+    seed 000's 0; :func:`spin_bulk_pressure` takes it out again through the pressure. Unlike the particle spins of Müller et al. this adds no variable: w is
     slaved to the local vorticity, so angular momentum is conserved to first order (exactly
     for a linear field). Rigid rotation then has no viscous force at all.
 
@@ -145,6 +146,28 @@ def local_spin(g):
     ``test_spin_correction``).
     """
     return 0.5 * (g[5] - g[7]), 0.5 * (g[6] - g[2]), 0.5 * (g[1] - g[3])
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def spin_bulk_ratio(dimension):
+    """ζ/μ = (d + 2)/(2d) of the spin-corrected pair form (5/6 in 3D, 1 in 2D), which
+    :func:`spin_bulk_pressure` removes.
+
+    Why [derived]: :func:`local_spin`'s stress σ = μ(∇v + ∇vᵀ) + (d − 2)/(2d) μ (∇·v) I is
+    2μ(E − (∇·v)/d I) + ζ (∇·v) I with ζ = 2μ/d + (d − 2)/(2d) μ = (d + 2)/(2d) μ, where seed
+    000's form has ζ = 0. A weakly compressible fluid squeezed out of a closing gap is not
+    divergence-free, and there ζ adds a resistance the incompressible fluid does not have.
+    """
+    return (dimension + 2.0) / (2.0 * dimension)
+
+
+@njit(inline="always", **JIT_OPTIONS)
+def spin_bulk_pressure(mu, g, ratio):
+    """ζ ∇·v = ``ratio`` μ (g[0] + g[4] + g[8]) [m h^(2−d) τ^−2], added to a fluid particle's
+    pressure so that the spin-corrected form's bulk stress ζ (∇·v) I cancels (the pressure
+    enters the stress as −P I; :func:`spin_bulk_ratio`). ``g`` the corrected gradient g[3k + l]
+    = ∂_k v_l, μ the particle's (normalised) viscosity."""
+    return ratio * mu * (g[0] + g[4] + g[8])
 
 
 @njit(inline="always", **JIT_OPTIONS)
