@@ -131,9 +131,10 @@ def local_spin(g):
     (L − W) r = E r: the stress μK [(β/d + 2α/(d(d + 2))) E + α/(d(d + 2)) tr E I] is
     symmetric. Its divergence keeps μ ∇²v when β is doubled (α unchanged), so the shear
     viscosity is the same, and the bulk viscosity becomes ζ = 5μ/6 in 3D (μ in 2D) instead of
-    seed 000's 0; :func:`spin_bulk_pressure` takes it out again through the pressure. Unlike the particle spins of Müller et al. this adds no variable: w is
-    slaved to the local vorticity, so angular momentum is conserved to first order (exactly
-    for a linear field). Rigid rotation then has no viscous force at all.
+    seed 000's 0; :func:`spin_bulk_pressure` takes it out again through the pressure. Unlike
+    the particle spins of Müller et al. this adds no variable: w is slaved to the local
+    vorticity, so angular momentum is conserved to first order (exactly for a linear field).
+    Rigid rotation then has no viscous force at all.
 
     Variable viscosity [derived]: expanding the pair sum to second order in r with μ_i + μ_j
     = 2μ − r·∇μ and w̄ = w − ½ (r·∇) w gives, besides the terms above, (α/(d(d + 2)))K
