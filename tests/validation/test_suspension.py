@@ -130,16 +130,20 @@ SPIN_CORRECTION = {"numerics.spin_correction": True}
 
 def test_torque_free_sphere_turns_with_the_fluid():
     """A torque-free sphere in simple shear turns at Ω = −γ̇/2 (Stokes; its images at φ = 0.03
-    change that by O(φ)): with ``numerics.spin_correction`` the mean Ω_z over the samples is
-    within 3 % of it. Measured (one sphere, a = 2.5 h, 12.5 h box, strain 1 + 2, 2026-12-06):
-    1.014 × γ̇/2 (1.001 before the correction's bulk viscosity went through the pressure, 0.995
-    before fluid–body pairs took the mean spin; 0.866 with numerics.shifting 100); without the
-    correction 1.26 (``docs/figures/make_sphere_spin.py``)."""
-    sc = suspension_scene(phi=0.03, radius=2.5, box=12.5, seed=1, strain=3.0,
+    change that by O(φ)): with ``numerics.spin_correction`` the mean Ω_z over strain 1 + 4
+    (1 + 2 at CI size) is within 5 % of it, where the uncorrected form reads 1.26. The 5 % is
+    the strain units' scatter: measured (one sphere, a = 2.5 h, 12.5 h box, 2026-12-06, the
+    correction's bulk viscosity removed) single units read 0.963, 1.066, 1.064 and 1.032 × γ̇/2
+    (standard deviation 0.048), the mean of four 1.031, of the first two 1.014 (one unit alone
+    missed 3 % in CI). Before the bulk viscosity went through the pressure two units read
+    1.001, and 0.995 before fluid–body pairs took the mean spin; A = 100 reads 0.866
+    (``docs/figures/make_sphere_spin.py``)."""
+    units = 2.0 if REDUCED else 4.0
+    sc = suspension_scene(phi=0.03, radius=2.5, box=12.5, seed=1, strain=1.0 + units,
                           overrides=SPIN_CORRECTION)
     spins = [sim.bodies.angular_velocities()[0, 2] / (0.5 * RATE)
-             for sim in sampled_run(sc, transient=1.0, units=1.0 if REDUCED else 2.0)]
-    assert sum(spins) / len(spins) == pytest.approx(-1.0, abs=0.03)
+             for sim in sampled_run(sc, transient=1.0, units=units)]
+    assert sum(spins) / len(spins) == pytest.approx(-1.0, abs=0.05)
 
 
 @pytest.mark.parametrize("phi", [pytest.param(0.1, marks=FULL_SIZE), 0.2,
