@@ -39,8 +39,9 @@ def main() -> None:
     settings = overrides_text(overrides)
     low, high = published_envelope(args.phi)
     print(f"φ = {args.phi} (published envelope {low:.2f}–{high:.2f}), box "
-          f"{args.box_per_radius:g} a, strain {transient:g} + {units}{settings}\n| a [h] | box [h] | seed | φ packed | η_r | "
-          "CPU [s] | particles |\n|---|---|---|---|---|---|---|", flush=True)
+          f"{args.box_per_radius:g} a, strain {transient:g} + {units}{settings}\n"
+          "| a [h] | box [h] | seed | φ packed | η_r | CPU [s] | particles |\n"
+          "|---|---|---|---|---|---|---|", flush=True)
     for radius in args.radii:
         for seed in args.seeds:
             box = SPACING * round(args.box_per_radius * radius / SPACING)

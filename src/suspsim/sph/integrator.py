@@ -92,13 +92,13 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     scene has rigid bodies (angular velocities ``body_spin`` (B, 3), for
     ``terms.viscous.spin_free_velocity``; a (1, 3) array of zeros without bodies), whose
     particles (``body_of`` (N,) ≥ 0; −1 for fluid) have no pairs inside their own body in the
-    list (``group`` of ``neighbours.build_neighbour_list``) and take their density and μ̂ from the fluid around
-    them (``density.body_particle_density``); their gradient, rate and inverse moment are 0
-    and the normalisation keeps their μ̂ (``velocity_pass``). ``spin_correction``
-    (``numerics.spin_correction``, which needs ``velocity_gradient``) takes the β term of
-    fluid–fluid pairs relative to the particles' local spin (``terms.viscous.local_spin``),
-    normalises by the strain rate alone and removes its bulk viscosity through the pressure
-    (``terms.viscous.spin_bulk_pressure``).
+    list (``group`` of ``neighbours.build_neighbour_list``) and take their density and μ̂
+    from the fluid around them (``density.body_particle_density``); their gradient, rate and
+    inverse moment are 0 and the normalisation keeps their μ̂ (``velocity_pass``).
+    ``spin_correction`` (``numerics.spin_correction``, which needs ``velocity_gradient``)
+    takes the β term of fluid–fluid pairs relative to the particles' local spin
+    (``terms.viscous.local_spin``), normalises by the strain rate alone and removes its bulk
+    viscosity through the pressure (``terms.viscous.spin_bulk_pressure``).
     """
     shear_ly = shear_rate * box[1]
     code = summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours,

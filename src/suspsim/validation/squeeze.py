@@ -480,13 +480,15 @@ def cutoff_gap(gap, ratio, threshold: float = CUTOFF_RATIO) -> float:
 
 def squeeze_study(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, reynolds: float = REYNOLDS,
                   viscosity: float = 1.0, threads: int = 1, per_decade: int = 8,
-                  end_gap: float = 0.05, drag: dict | None = None, **kwargs) -> xr.Dataset:
-    """Single-sphere calibration plus the approach run, as one Dataset (module docstring)."""
+                  end_gap: float = 0.05, drag: dict | None = None,
+                  numerics: dict | None = None, **kwargs) -> xr.Dataset:
+    """Single-sphere calibration plus the approach run, as one Dataset (module docstring);
+    ``numerics`` scene keys of both runs (:func:`squeeze_run`)."""
     if drag is None:
         drag = stokes_drag(radius, box, viscosity=viscosity, reynolds=reynolds,
-                           threads=threads, numerics=kwargs.get("numerics"))
+                           threads=threads, numerics=numerics)
     run = squeeze_run(radius, box, viscosity=viscosity, reynolds=reynolds, threads=threads,
-                      end_gap=end_gap, **kwargs)
+                      end_gap=end_gap, numerics=numerics, **kwargs)
     run["reynolds"] = reynolds
     return squeeze_dataset(run, drag, radius, box, viscosity=viscosity, per_decade=per_decade,
                            end_gap=end_gap)
