@@ -8,7 +8,9 @@ Runs :func:`suspsim.validation.squeeze.squeeze_study` for a = 2.5 h (box 25 × 2
 Re = 0.05, and the same at half the speed for the quasi-steady check) and a = 4 h (box
 32 × 25 × 25 h, Re = 0.1; skipped with --no-large), draws them with
 :func:`suspsim.plotting.squeeze.plot_squeeze` and prints the table s, F/F_theory and the
-recommended cutoff gap. --reduced: the test's small case only. The runs are kept in
+recommended cutoff gap, and the resolved force plus the lubrication correction at the cutoff
+the scene applies (auto: ``scene_rules.AUTO_CUTOFF_GAP_CORRECTED``). --reduced: the test's small
+case only. The runs are kept in
 ``squeeze_force.nc`` (netCDF4 groups, one per run, named by its label). ``--set`` takes
 numerics keys of the runs' scenes (VALUE as JSON, e.g. ``numerics.shifting=100``); such runs
 print their tables and write no file.
@@ -33,11 +35,12 @@ def _table(data, title):
           f"Re = {a['particle_reynolds_number']:g}, a_h/a = {a['hydrodynamic_radius_ratio']:.3f}"
           f", {a['n_particles']} particles, wall {a['squeeze_wall_time_s']:.0f} s + "
           f"{a['drag_wall_time_s']:.0f} s; cutoff gap s_c = {a['cutoff_gap']:.3g} h")
-    print("   s [h]   F/(6pi mu a U)   F/F_th(a_h)   F/F_th(a)   box/free")
-    for s, n, r, rn, c in zip(data["gap"].values, data["normalised_force"].values,
-                              data["ratio"].values, data["ratio_nominal"].values,
-                              data["image_correction"].values):
-        print(f"  {s:6.3f}   {n:12.4g}   {r:11.3f}   {rn:9.3f}   {c:8.3f}")
+    print(f"lubrication correction at the scene's cutoff {a['lubrication_cutoff_gap']:.3g} h")
+    print("   s [h]   F/(6pi mu a U)   F/F_th(a_h)   F/F_th(a)   +lub./F_th(a)   box/free")
+    for s, n, r, rn, rc, c in zip(data["gap"].values, data["normalised_force"].values,
+                                  data["ratio"].values, data["ratio_nominal"].values,
+                                  data["ratio_combined"].values, data["image_correction"].values):
+        print(f"  {s:6.3f}   {n:12.4g}   {r:11.3f}   {rn:9.3f}   {rc:13.3f}   {c:8.3f}")
 
 
 def _save(runs, labels) -> None:
@@ -77,7 +80,7 @@ def main() -> None:
                 runs.append(node.to_dataset().load())
                 labels.append(node.attrs["label"])
     elif args.reduced:
-        runs.append(squeeze_study(2.5, (20.0, 15.0, 15.0), reynolds=0.1, end_gap=0.2,
+        runs.append(squeeze_study(2.5, (20.0, 15.0, 15.0), reynolds=0.1, end_gap=0.1,
                                   **common))
         labels.append("a = 2.5 h, reduced")
     else:

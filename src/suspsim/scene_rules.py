@@ -54,10 +54,11 @@ def resolve(scene: dict, given_run: dict, fail: Fail) -> tuple[dict, Constitutiv
     out["flow"] = _check_flow(scene["flow"], fail)
     out["run"] = _resolve_run(scene["run"], given_run, out["flow"], scene["box"], fail)
     _check_lattice(out["dimension"], scene["box"], scene["number_density"], fail)
-    _check_inclusions(out, fail)
     inclusions = _has_inclusions(scene["inclusions"])
     out["numerics"] = _resolve_numerics(scene["numerics"], inclusions, out["flow"],
                                         law.is_newtonian, fail)
+    out["inclusions"] = _resolve_cutoff(scene["inclusions"], out["numerics"])
+    _check_inclusions(out, fail)
     _resolve_density_limits(out["run"], inclusions, fail)
     return out, law
 
@@ -123,9 +124,52 @@ AUTO_SHIFTING_WITH_INCLUSIONS = 30.0
 AUTO_SHIFTING_NON_NEWTONIAN = 3.0
 
 
+#: Lubrication cutoff s_c [h] of inclusions.lubrication.cutoff_gap auto with
+#: numerics.spin_correction, by shifting coefficient A [choice]: the largest gap at which the
+#: resolved two-sphere squeeze force falls below 0.9 of Jeffrey–Onishi
+#: (``validation.squeeze.cutoff_gap``; a = 2.5 h, Re = 0.05, docs/figures/make_squeeze.py
+#: --set numerics.spin_correction=true --set numerics.shifting=A). Other A interpolate in log A
+#: and hold the end values beyond. Stronger shifting resolves the squeeze to closer gaps, and a
+#: larger cutoff would count the resolved force twice.
+AUTO_CUTOFF_GAP_CORRECTED = ((3.0, 0.58), (30.0, 0.185), (100.0, 0.14))
+#: The same without the spin correction (A = 30; the resolved force stays within 10 % of
+#: Jeffrey–Onishi down to 0.58 h).
+AUTO_CUTOFF_GAP_UNCORRECTED = 0.6
+
+
+def _resolve_cutoff(inclusions: dict, numerics: dict) -> dict:
+    """``inclusions.lubrication.cutoff_gap`` auto → :data:`AUTO_CUTOFF_GAP_CORRECTED` at the
+    scene's shifting coefficient with the spin correction, else
+    :data:`AUTO_CUTOFF_GAP_UNCORRECTED`."""
+    lub = dict(inclusions["lubrication"])
+    if lub["cutoff_gap"] == "auto":
+        lub["cutoff_gap"] = AUTO_CUTOFF_GAP_UNCORRECTED
+        if numerics["spin_correction"]:
+            lub["cutoff_gap"] = _log_interpolate(AUTO_CUTOFF_GAP_CORRECTED, numerics["shifting"])
+    lub["cutoff_gap"] = float(lub["cutoff_gap"])
+    return {**inclusions, "lubrication": lub}
+
+
+def _log_interpolate(points, x: float) -> float:
+    """y(x) piecewise linear in (log x, log y) through ``points`` ((x, y), x increasing), held at
+    the end values beyond them."""
+    (x0, y0), (xn, yn) = points[0], points[-1]
+    if x <= x0:
+        return y0
+    if x >= xn:
+        return yn
+    for (xa, ya), (xb, yb) in zip(points, points[1:]):
+        if x <= xb:
+            t = math.log(x / xa) / math.log(xb / xa)
+            return math.exp((1 - t) * math.log(ya) + t * math.log(yb))
+
+
 def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, newtonian: bool,
                       fail: Fail) -> dict:
-    """``shifting`` auto → :data:`AUTO_SHIFTING_WITH_INCLUSIONS` with inclusions
+    """``spin_correction`` auto → on with inclusions, off without (a fluid alone has nothing
+    its angular momentum couples to, and the correction costs accuracy at kinks of the rate,
+    ``terms.viscous.local_spin``); ``shifting`` auto → :data:`AUTO_SHIFTING_WITH_INCLUSIONS`
+    with inclusions
     (:data:`AUTO_SHIFTING_NON_NEWTONIAN` in a non-Newtonian matrix), 0 without;
     ``shifting_rate`` auto → the imposed shear rate of a couette flow, 0 otherwise (shifting's
     diffusivity is A h² γ_s δt, ``terms.shifting``); ``rate_smoothing`` auto → on where
@@ -133,6 +177,9 @@ def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, newt
     auto → fluid_mean where shifting acts (A > 0 and γ_s > 0), nominal elsewhere; an explicit fluid_mean where it
     does not is refused (particles pair up, SPEC §2.3)."""
     out = dict(numerics)
+    if numerics["spin_correction"] == "auto":
+        out["spin_correction"] = inclusions_present
+    out["spin_correction"] = bool(out["spin_correction"])
     if numerics["shifting"] == "auto":
         with_inclusions = (AUTO_SHIFTING_WITH_INCLUSIONS if newtonian
                            else AUTO_SHIFTING_NON_NEWTONIAN)

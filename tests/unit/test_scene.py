@@ -239,6 +239,33 @@ def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected)
     assert suspension.numerics.pressure_reference == "fluid_mean"
 
 
+@pytest.mark.parametrize("extra, spin, cutoff", [
+    ("", True, 0.58), ("numerics: {shifting: 30}\n", True, 0.185),
+    ("numerics: {shifting: 100}\n", True, 0.14), ("numerics: {shifting: 300}\n", True, 0.14),
+    ("numerics: {shifting: 10}\n", True, 0.319),
+    ("numerics: {spin_correction: false, shifting: 30}\n", False, 0.6)])
+def test_spin_correction_and_cutoff_auto_follow_the_squeeze_calibration(tmp_path, extra, spin,
+                                                                       cutoff):
+    """The correction is on with bodies only; the auto cutoff is the calibrated gap at the
+    scene's shifting coefficient (A = 3 auto in this non-Newtonian matrix), interpolated in
+    log A between the measured 3, 30 and 100; an explicit cutoff stays."""
+    fluid = load_scene(_write(tmp_path, MINIMAL + extra))
+    suspension = load_scene(_write(tmp_path, MINIMAL + extra
+                                   + "inclusions: {phi: 0.1, radius: 2.0}\n"))
+    assert not fluid.numerics.spin_correction
+    assert suspension.numerics.spin_correction is spin
+    assert suspension.inclusions.lubrication.cutoff_gap == pytest.approx(cutoff, abs=1e-3)
+    given = load_scene(_write(tmp_path, MINIMAL + extra + "inclusions: {phi: 0.1, radius: 2.0, "
+                              "lubrication: {cutoff_gap: 0.4}}\n"))
+    assert given.inclusions.lubrication.cutoff_gap == 0.4
+
+
+def test_an_auto_cutoff_below_min_gap_is_refused(tmp_path):
+    with pytest.raises(InputError, match="min_gap 0.2 must be below cutoff_gap 0.185"):
+        load_scene(_write(tmp_path, MINIMAL + "numerics: {shifting: 30}\ninclusions: {phi: 0.1, "
+                          "radius: 2.0, lubrication: {min_gap: 0.2}}\n"))
+
+
 def test_density_limits_let_outliers_pass_only_with_inclusions(tmp_path):
     fluid = load_scene(_write(tmp_path, MINIMAL)).run
     suspension = load_scene(_write(tmp_path, MINIMAL + "inclusions: {phi: 0.1, radius: 2.0}\n")).run

@@ -13,7 +13,9 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
     ``datasets``: outputs of :func:`suspsim.validation.squeeze.squeeze_study` (a Dataset or a
     sequence). Top: F/(6πμaU) measured (markers) and the theory with the nominal radius a, which
     the Einstein coefficient calibrates (line; dashed: the drag's hydrodynamic radius a_h).
-    Bottom: F_SPH/F_theory(a) with the ``threshold`` line and each run's cutoff gap s_c marked.
+    Bottom: F_SPH/F_theory(a) with the ``threshold`` line and each run's recommended cutoff gap
+    s_c marked; open squares: the same plus the lubrication correction the run's scene applies
+    (``ratio_combined``, where the dataset has it).
     ``labels``: legend entries (default: a, a_h/a, U).
     """
     if isinstance(datasets, xr.Dataset):
@@ -33,6 +35,9 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
         top.plot(gap, data["theory_force_nominal"].values / scale, "-", color=colour, lw=1.2)
         top.plot(gap, data["theory_force"].values / scale, "--", color=colour, lw=0.8)
         bottom.plot(gap, data["ratio_nominal"].values, "o-", ms=3, color=colour, label=label)
+        if "ratio_combined" in data:
+            bottom.plot(gap, data["ratio_combined"].values, "s--", ms=3, mfc="none",
+                        color=colour, lw=0.8)
         cutoff = data.attrs.get("cutoff_gap", np.nan)
         if np.isfinite(cutoff):
             bottom.axvline(cutoff, color=colour, ls=":", lw=1)
@@ -43,7 +48,9 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
     top.set_ylabel("squeeze force F/(6πμaU) [1]")
     top.legend(fontsize="small")
     bottom.axhline(1.0, color="0.5", lw=0.8)
-    bottom.axhline(threshold, color="0.3", ls="--", lw=0.8, label=f"{threshold:g} × theory")
+    bottom.plot([], [], "ks--", ms=3, mfc="none", lw=0.8,
+                label="with the lubrication correction at the scene's cutoff")
+    bottom.axhline(threshold, color="0.3", ls=":", lw=0.8, label=f"{threshold:g} × theory")
     bottom.set_xlabel("surface gap s = r − 2a [h]")
     bottom.set_ylabel("F_SPH / F_theory(a) [1]")
     bottom.legend(fontsize="small")
