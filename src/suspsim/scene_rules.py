@@ -169,8 +169,7 @@ def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, newt
     """``spin_correction`` auto → on with inclusions, off without (a fluid alone has nothing
     its angular momentum couples to, and the correction costs accuracy at kinks of the rate,
     ``terms.viscous.local_spin``); ``shifting`` auto → :data:`AUTO_SHIFTING_WITH_INCLUSIONS`
-    with inclusions
-    (:data:`AUTO_SHIFTING_NON_NEWTONIAN` in a non-Newtonian matrix), 0 without;
+    with inclusions (:data:`AUTO_SHIFTING_NON_NEWTONIAN` in a non-Newtonian matrix), 0 without;
     ``shifting_rate`` auto → the imposed shear rate of a couette flow, 0 otherwise (shifting's
     diffusivity is A h² γ_s δt, ``terms.shifting``); ``rate_smoothing`` auto → on where
     shifting acts on a non-Newtonian fluid (``terms.rate_smoothing``); ``pressure_reference``
