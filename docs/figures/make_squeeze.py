@@ -10,8 +10,8 @@ Re = 0.05, and the same at half the speed for the quasi-steady check) and a = 4 
 :func:`suspsim.plotting.squeeze.plot_squeeze` and prints the table s, F/F_theory and the
 recommended cutoff gap, and the resolved force plus the lubrication correction at the cutoff
 the scene applies (auto: ``scene_rules.AUTO_CUTOFF_GAP_CORRECTED``). --reduced: the test's small
-case only. The runs are kept in
-``squeeze_force.nc`` (netCDF4 groups, one per run, named by its label). ``--set`` takes
+case only, printed and not written. The runs are kept in ``squeeze_force.nc`` (netCDF4
+groups, one per run, named by its label). ``--set`` takes
 numerics keys of the runs' scenes (VALUE as JSON, e.g. ``numerics.shifting=100``); such runs
 print their tables and write no file.
 """
@@ -94,7 +94,7 @@ def main() -> None:
             labels.append("a = 4 h, Re = 0.1")
     for data, label in zip(runs, labels):
         _table(data, label)
-    if numerics:
+    if numerics or args.reduced:
         return
     if not args.plot_only:
         _save(runs, labels)
