@@ -41,7 +41,7 @@ from suspsim.sph.simulation import SUPPORT, Simulation
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
                                              _normalisation_finish)
-from suspsim.sph.terms.viscous import spin_bulk_ratio
+from suspsim.sph.terms.viscous import spin_bulk_coefficient
 from suspsim.threads import use_threads
 from suspsim.timing import best_times
 
@@ -189,7 +189,7 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
         sim._v, sim._rho, sim._volume, sim._mu_hat, sim._mass, sim._rho_eq, sim.sound_speed ** 2,
         sim._alpha, sim._beta, sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of,
         sim._body_spin, sim._spin_correction,
-        spin_bulk_ratio(sim.scene.dimension) if sim._spin_correction else 0.0, sim._gradient,
+        spin_bulk_coefficient(sim._spin_correction, sim.scene.dimension), sim._gradient,
         sim._pressure, sim._force_acc, sim._force_scratch, sim._bounds, sim._virial)
     calls["force finish"] = lambda: force_finish(
         sim._force_acc, sim._x, sim._rho, sim._inverse_moment, sim._gradient, sim._mass,

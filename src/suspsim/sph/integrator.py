@@ -29,7 +29,7 @@ from suspsim.sph.density import (TABLE_OK, body_particle_density, mass_density,
 from suspsim.sph.neighbours import needs_rebuild
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
-from suspsim.sph.terms.viscous import spin_bulk_ratio
+from suspsim.sph.terms.viscous import spin_bulk_coefficient
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
                                              _normalisation_finish, normalisation_due)
 
@@ -135,11 +135,11 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
         for i in range(viscosity.shape[0]):
             if body_of[i] < 0:
                 viscosity_hat[i] = viscosity[i]
-    spin_bulk = spin_bulk_ratio(dimension) if spin_correction else 0.0
     force_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
                volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
-               shear_ly, body_of, body_spin, spin_correction, spin_bulk, gradient, pressure,
-               force_acc, force_scratch, bounds, virial)
+               shear_ly, body_of, body_spin, spin_correction,
+               spin_bulk_coefficient(spin_correction, dimension), gradient, pressure, force_acc,
+               force_scratch, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
     return TABLE_OK

@@ -70,7 +70,7 @@ from numba import njit
 from scipy.optimize import brentq
 from scipy.special import erfc
 
-from suspsim.bodies.lubrication import x11a_singular
+from suspsim.bodies.lubrication import pair_mode_resistances
 from suspsim.io.provenance import provenance
 from suspsim.io.variables import UNIT_SYSTEM
 from suspsim.scene_rules import AUTO_SHIFTING_WITH_INCLUSIONS
@@ -402,16 +402,14 @@ def stokes_drag(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float
 def lubrication_correction(gap, radius: float, viscosity: float, speed: float,
                            cutoff_gap: float, min_gap: float) -> np.ndarray:
     """The squeeze force the simulation adds to the resolved one for two equal spheres of
-    radius a approaching at ``speed`` U each, in correction form (``bodies.lubrication``):
-    F = 6πμa (2U) [X11A(ξ) − X11A(ξ_c)] for s < s_c, 0 beyond, with the singular X11A of Jeffrey
-    & Onishi, ξ = max(s, s_min)/a and ξ_c = s_c/a [m h τ⁻²]; ``gap`` s, ``cutoff_gap`` s_c and
+    radius a approaching at ``speed`` U each: μ M_n(s) (2U), with the correction-form squeeze
+    resistance of ``bodies.lubrication.pair_mode_resistances``, 6πa [X11A(ξ) − X11A(ξ_c)] for
+    s < s_c and 0 beyond, ξ = max(s, s_min)/a [m h τ⁻²]; ``gap`` s, ``cutoff_gap`` s_c and
     ``min_gap`` s_min [h]."""
     gap = np.asarray(gap, dtype=float)
-    xi = np.maximum(gap, min_gap) / radius
-    table = np.array([x11a_singular(x, 1.0) for x in xi.ravel()]).reshape(xi.shape)
-    excess = table - x11a_singular(cutoff_gap / radius, 1.0)
-    return np.where(gap < cutoff_gap, 6.0 * math.pi * viscosity * radius * 2.0 * speed * excess,
-                    0.0)
+    squeeze = [pair_mode_resistances(radius, radius, s, cutoff_gap, min_gap)[0]
+               for s in gap.ravel()]
+    return viscosity * 2.0 * speed * np.array(squeeze).reshape(gap.shape)
 
 
 def bin_series(gap, force, edges):

@@ -163,6 +163,13 @@ def spin_bulk_ratio(dimension):
 
 
 @njit(inline="always", **JIT_OPTIONS)
+def spin_bulk_coefficient(spin_correction, dimension):
+    """The ζ/μ a step removes (``force_pass.force_sums``' ``spin_bulk``): :func:`spin_bulk_ratio`
+    with the spin correction, 0 without."""
+    return spin_bulk_ratio(dimension) if spin_correction else 0.0
+
+
+@njit(inline="always", **JIT_OPTIONS)
 def spin_bulk_pressure(mu, g, ratio):
     """ζ ∇·v = ``ratio`` μ (g[0] + g[4] + g[8]) [m h^(2−d) τ^−2], added to a fluid particle's
     pressure so that the spin-corrected form's bulk stress ζ (∇·v) I cancels (the pressure
