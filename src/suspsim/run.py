@@ -25,7 +25,9 @@ Output (:mod:`suspsim.io.netcdf`): the time series, the steady-window profiles, 
 :func:`~suspsim.analysis.steady.steady_mean` (batch means over ≥ 8 blocks of whole strain
 units); with inclusions also ``phi``, ``suspension_viscosity`` (the same ⟨σ_xy⟩/γ̇),
 ``matrix_viscosity_at_rate`` μ(γ̇) of the scene's law and ``relative_viscosity`` (± stderr)
-η_r = ⟨σ_xy⟩/(γ̇ μ(γ̇)) (SPEC §3.5). A poiseuille flow has no single viscosity: both are omitted (its viscosity lives in
+η_r = ⟨σ_xy⟩/(γ̇ μ(γ̇)) (SPEC §3.5), the series ``particle_stress`` (the bodies' share of σ_xy),
+and in a Newtonian matrix Batchelor's split of η_r (:func:`_batchelor_split`). A poiseuille
+flow has no single viscosity: both are omitted (its viscosity lives in
 ``viscosity_profile``). The Reynolds number's scales are those of :mod:`suspsim.analysis.steady`.
 """
 from __future__ import annotations
@@ -154,6 +156,12 @@ class Record:
         return cls(state["series"], state.get("sums"), state["n_profiles"])
 
 
+class SuspensionRecord(Record):
+    """A run with inclusions: :class:`Record` with the bodies' share of σ_xy as well."""
+
+    sample_names = SAMPLE_NAMES + ("particle_stress",)
+
+
 def run_scene(scene: Scene | str | PathLike, out_path: str | PathLike, *, resume: bool = False,
               threads: int | None = None, progress: ProgressReporter | None = None,
               simulation_factory=None, clock=time.monotonic,
@@ -172,8 +180,10 @@ def run_scene(scene: Scene | str | PathLike, out_path: str | PathLike, *, resume
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     out, ckpt = Path(out_path), checkpoint_path(out_path)
     threads = scene.run.threads if threads is None else threads
+    record_class = SuspensionRecord if scene.inclusions.present else Record
     sim, record, wall_before = start_simulation(scene, ckpt, resume,
-                                                simulation_factory or _solver(), threads, Record)
+                                                simulation_factory or _solver(), threads,
+                                                record_class)
     plan = Plan.for_scene(scene, sim.dt)
     log.info("%d particles, dt %.4g tau, sound speed %.4g h/tau: %d steps, a sample every %d, "
              "checkpoint %s", sim.n_particles, sim.dt, sim.sound_speed, plan.total_steps,
@@ -333,7 +343,8 @@ def _failure(message: str, where: str, ckpt: Path, *,
 def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall: float,
                   extra_attrs: dict[str, Any]) -> None:
     series = record.arrays()
-    data: dict[str, Any] = {"time": series["time"], **{k: series[k] for k in SAMPLE_NAMES}}
+    data: dict[str, Any] = {"time": series["time"],
+                            **{k: series[k] for k in record.sample_names}}
     if scene.flow.type == "couette":
         data["strain"] = series["strain"]
         steady = np.array([plan.is_steady(int(s)) for s in series["step"]], dtype=bool)
@@ -349,6 +360,8 @@ def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall
                         matrix_viscosity_at_rate=matrix,
                         relative_viscosity=data["viscosity"] / matrix,
                         relative_viscosity_stderr=data["viscosity_stderr"] / matrix)
+            if scene.fluid.law.is_newtonian:
+                data.update(_batchelor_split(series, steady, scene.flow.shear_rate * matrix))
     data["y"] = record.sums["y"]
     for name in PROFILE_NAMES:
         data[name] = record.sums[name] / record.n_profiles
@@ -364,6 +377,28 @@ def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall
     write_run(out, data, attrs, scene)
     log.info("wrote %s (Re %.3g, max Mach %.3g)", out, attrs["reynolds_number"],
              attrs["mach_number"])
+
+
+def _batchelor_split(series: dict[str, np.ndarray], steady: np.ndarray,
+                     scale: float) -> dict[str, float]:
+    """A Newtonian matrix's η_r from the bodies' share of the stress alone, and the fluid's.
+
+    Batchelor (1970, J. Fluid Mech. 41, 545): in a Newtonian matrix of viscosity μ the bulk
+    stress is σ = −p I + 2μE + (1/V) Σ_B S_B, the fluid's share exactly 2μE however the bodies
+    move, so ``particle_relative_viscosity`` = 1 + ⟨σ^p_xy⟩/(μγ̇) (σ^p the series
+    ``particle_stress``) leaves out the discrete fluid's own error, which
+    ``fluid_stress_error`` = ⟨σ_xy − σ^p_xy⟩/(μγ̇) − 1 reports (0 in the continuum). Both ± the
+    batch-means standard error; ``scale`` = μγ̇ [stress]. A shear-thinning matrix has no such
+    split (its fluid share depends on the local rates), so only Newtonian runs write them.
+    """
+    strain = series["strain"][steady]
+    particle = steady_mean(strain, series["particle_stress"][steady])
+    fluid = steady_mean(strain, series["shear_stress"][steady]
+                        - series["particle_stress"][steady])
+    return {"particle_relative_viscosity": 1.0 + particle.mean / scale,
+            "particle_relative_viscosity_stderr": particle.stderr / scale,
+            "fluid_stress_error": fluid.mean / scale - 1.0,
+            "fluid_stress_error_stderr": fluid.stderr / scale}
 
 
 def _strip(state: dict[str, Any], prefix: str) -> dict[str, Any]:

@@ -103,6 +103,21 @@ VARIABLES: Mapping[str, Variable] = MappingProxyType({v.name: v for v in (
              "same shear rate"),
     Variable("relative_viscosity_stderr", (), "standard error of relative_viscosity (block "
              "averaging)"),
+    Variable("particle_stress", _T, "the bodies' share of sigma_xy: their stresslets plus "
+             "lubrication and repulsion, (1/V) sum_B S_B,xy", _STRESS,
+             comment="Batchelor, J. Fluid Mech. 41, 545 (1970); SPEC 3.5"),
+    Variable("particle_relative_viscosity", (), "1 + particle_stress/(matrix viscosity x shear "
+             "rate) averaged after the transient: relative viscosity from the bodies' share "
+             "alone, the fluid's taken at its law (Newtonian matrix only)",
+             comment="Batchelor (1970): in a Newtonian matrix the fluid's share is exactly "
+             "2 mu E around rigid bodies"),
+    Variable("particle_relative_viscosity_stderr", (), "standard error of "
+             "particle_relative_viscosity (block averaging)"),
+    Variable("fluid_stress_error", (), "the rest of sigma_xy (fluid pairs and kinetic stress) "
+             "over matrix viscosity x shear rate, minus 1: the discrete fluid's departure from "
+             "its law, 0 in the continuum (Newtonian matrix only)"),
+    Variable("fluid_stress_error_stderr", (), "standard error of fluid_stress_error (block "
+             "averaging)"),
 )})
 
 

@@ -50,7 +50,7 @@ from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbo
                                     build_neighbour_list, needs_rebuild, raise_for_code,
                                     rebuild_neighbour_list, sort_by_cell)
 from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
-from suspsim.sph.terms.force_pass import force_width
+from suspsim.sph.terms.force_pass import VXY, force_width
 from suspsim.sph.terms.shifting import shift_particles
 from suspsim.sph.terms.velocity_pass import GRADIENT_WIDTH
 from suspsim.sph.terms.viscous import bulk_factor, viscous_weights
@@ -645,15 +645,22 @@ class Simulation:
 
     def sample(self) -> dict[str, float]:
         """Instantaneous scalars: shear_stress σ_xy, pressure tr Π/d, kinetic_energy of ṽ,
-        density_error, mach (SPEC §2.8)."""
+        density_error, mach (SPEC §2.8); with bodies also particle_stress, the bodies' share
+        of σ_xy: their stresslets (the move of the body particles' forces to the centre, SPEC
+        §3.5) plus lubrication and repulsion, (1/V) Σ_B S_B,xy of Batchelor (1970) [m h^(2−d)
+        τ⁻²]."""
         peculiar = self._peculiar()
         rows = self._virial if self.bodies is None else np.vstack(
             [self._virial, self._body_virial, self._lubrication_virial])
         pi = pressure_tensor(rows, peculiar, self._mass, self.scene.volume)
-        return {"shear_stress": shear_stress(pi),
-                "pressure": mean_pressure(pi, self.scene.dimension),
-                "kinetic_energy": 0.5 * self._mass * float(np.sum(peculiar * peculiar)),
-                "density_error": self._density_error(), "mach": self._mach()}
+        out = {"shear_stress": shear_stress(pi),
+               "pressure": mean_pressure(pi, self.scene.dimension),
+               "kinetic_energy": 0.5 * self._mass * float(np.sum(peculiar * peculiar)),
+               "density_error": self._density_error(), "mach": self._mach()}
+        if self.bodies is not None:
+            out["particle_stress"] = -float(self._body_virial[VXY]
+                                            + self._lubrication_virial[VXY]) / self.scene.volume
+        return out
 
     def profiles(self, bins: int) -> dict[str, np.ndarray]:
         """Bin means over y ∈ [0, L_y): y, velocity_profile (v_x), viscosity_profile (μ),

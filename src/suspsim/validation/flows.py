@@ -62,6 +62,17 @@ def couette_viscosity_ratio(sim, *, transient: float = 1.0, units: int = 3,
     means over √units. Raises NumericalError if the run left its health limits.
     ``on_sample(sim)``, if given, is called every sampling stride from the start, the transient
     included, to watch the run (it may raise to stop a run that went wrong)."""
+    ratios = couette_stress_ratios(sim, ("shear_stress",), transient=transient, units=units,
+                                   on_sample=on_sample)
+    return Reading(ratios["shear_stress"].value - 1.0, ratios["shear_stress"].stderr)
+
+
+def couette_stress_ratios(sim, names: tuple[str, ...], *, transient: float = 1.0,
+                          units: int = 3, on_sample: Callable[[Any], None] | None = None
+                          ) -> dict[str, Reading]:
+    """Each stress ``names`` of ``sim.sample()`` (e.g. ``shear_stress``, ``particle_stress``)
+    over μ(γ̇) γ̇, averaged as :func:`couette_viscosity_ratio` averages σ_xy, with the
+    strain-unit standard error."""
     scene = sim.scene
     rate = scene.flow.shear_rate
     per_unit = max(1, int(round(1.0 / (rate * sim.dt))))
@@ -72,17 +83,20 @@ def couette_viscosity_ratio(sim, *, transient: float = 1.0, units: int = 3,
         if on_sample is not None:
             on_sample(sim)
     per_block = per_unit // stride
-    stresses = np.empty(units * per_block)
-    for k in range(stresses.size):
+    stresses = np.empty((len(names), units * per_block))
+    for k in range(stresses.shape[1]):
         sim.advance(stride)
-        stresses[k] = sim.sample()["shear_stress"]
+        sample = sim.sample()
+        stresses[:, k] = [sample[name] for name in names]
         if on_sample is not None:
             on_sample(sim)
     _require_health(sim)
     expected = float(scene.fluid.law.viscosity(rate)) * rate
-    blocks = stresses.reshape(units, per_block).mean(axis=1) / expected
-    stderr = float(blocks.std(ddof=1) / np.sqrt(units)) if units > 1 else float("nan")
-    return Reading(float(blocks.mean()) - 1.0, stderr)
+    blocks = stresses.reshape(len(names), units, per_block).mean(axis=2) / expected
+    stderr = (blocks.std(axis=1, ddof=1) / np.sqrt(units) if units > 1
+              else np.full(len(names), np.nan))
+    return {name: Reading(float(blocks[n].mean()), float(stderr[n]))
+            for n, name in enumerate(names)}
 
 
 def poiseuille_mean_profile(sim, *, run_time: float, averaging: float

@@ -20,7 +20,7 @@ from suspsim.errors import NumericalError
 from suspsim.scene import Scene, scene_from_dict
 from suspsim.sph.lattice import imposed_velocity
 from suspsim.sph.simulation import Simulation
-from suspsim.validation.flows import SAMPLES_PER_UNIT, couette_viscosity_ratio
+from suspsim.validation.flows import SAMPLES_PER_UNIT, couette_stress_ratios
 
 RATE = 0.004
 """Imposed shear rate [τ⁻¹]."""
@@ -34,7 +34,9 @@ class SuspensionReading(NamedTuple):
     run's health over its samples (every 1/50 strain unit): the largest fluid
     ``density_error`` max|ρ/ρ_eq − 1| [1], the ``smallest_gap`` between body surfaces [h] and
     the largest body speed relative to the imposed flow, ``body_speed``, in units of the wall
-    speed γ̇L_y/2 [1]."""
+    speed γ̇L_y/2 [1]; ``particle_relative_viscosity`` 1 + σ^p_xy/(μγ̇) from the bodies' share
+    of the stress alone (Batchelor 1970; ``run._batchelor_split``) and its ``particle_stderr``
+    [1]."""
 
     relative_viscosity: float
     stderr: float
@@ -44,6 +46,8 @@ class SuspensionReading(NamedTuple):
     density_error: float
     smallest_gap: float
     body_speed: float
+    particle_relative_viscosity: float
+    particle_stderr: float
 
 
 class HealthWatch:
@@ -127,10 +131,13 @@ def relative_viscosity(*, shape: str = "sphere", phi: float, radius: float, box:
     started = time.process_time()
     sim = Simulation(scene, threads=threads)
     watch = HealthWatch()
-    reading = couette_viscosity_ratio(sim, transient=transient, units=units, on_sample=watch)
-    return SuspensionReading(1.0 + reading.value, reading.stderr,
-                             time.process_time() - started, sim.n_particles, sim.packing_phi,
-                             watch.density_error, watch.smallest_gap, watch.body_speed)
+    ratios = couette_stress_ratios(sim, ("shear_stress", "particle_stress"),
+                                   transient=transient, units=units, on_sample=watch)
+    total, particle = ratios["shear_stress"], ratios["particle_stress"]
+    return SuspensionReading(total.value, total.stderr, time.process_time() - started,
+                             sim.n_particles, sim.packing_phi, watch.density_error,
+                             watch.smallest_gap, watch.body_speed, 1.0 + particle.value,
+                             particle.stderr)
 
 
 def sampled_run(scene: Scene, *, transient: float, units: float) -> Iterator[Simulation]:
