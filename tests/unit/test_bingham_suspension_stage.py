@@ -11,6 +11,7 @@ import xarray as xr
 from suspsim.errors import InputError
 from suspsim.rheology.laws import make_law
 from suspsim.scene import scene_from_dict
+from suspsim.scene_rules import AUTO_SHIFTING_NON_NEWTONIAN
 from suspsim.stages.bingham_suspension import (case_name, find_job, matrix_law,
                                                matrix_plastic_ratio, pack_seed, study_settings,
                                                suspension_jobs, suspension_scene)
@@ -90,12 +91,17 @@ def test_scene_is_the_owners_set_up_with_the_seeds_packing_file():
     assert data["lattice"] == {"relax": True} and data["run"]["start"] == "linear"
     assert data["inclusions"]["packing"] == "results/packings/seed-1.nc"
     assert data["inclusions"]["phi"] == 0.4 and data["inclusions"]["radius"] == 2.5
-    assert "numerics" not in data  # the inclusions' defaults
-    # the particle Reynolds number ρ γ̇ a²/μ_m(γ̇) of every run, Newtonian or not
+    assert data["numerics"] == {}  # the inclusions' defaults
+    # the particle Reynolds number ρ γ̇ a²/μ_m(γ̇) of every run, Newtonian or not, and the
+    # numerics: the Newtonian reference takes those of the non-Newtonian runs
+    numerics = set()
     for case in ("newtonian", "x-1", "x-100"):
         other = scene_from_dict(suspension_scene(find_job(BLOCK, case, 1), None))
         mu = float(other.fluid.law.viscosity(other.flow.shear_rate))
         assert other.density * other.flow.shear_rate * 2.5 ** 2 / mu == pytest.approx(0.1024)
+        numerics.add((other.numerics.shifting, other.numerics.spin_correction,
+                       other.inclusions.lubrication.cutoff_gap))
+    assert len(numerics) == 1 and numerics.pop()[0] == AUTO_SHIFTING_NON_NEWTONIAN
 
 
 @pytest.mark.parametrize("change, key, message", [

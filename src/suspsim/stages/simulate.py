@@ -17,8 +17,8 @@ At φ > 0 the scene holds rigid inclusions (:class:`~suspsim.stages.pack.Particl
 ``inclusions``), read from the run's packing file (:mod:`suspsim.stages.pack`) when one is
 given, else packed by the scene itself from the same keys, which gives the same packing. The
 particle Reynolds number then takes the inclusion radius a [h] as its length (SPEC §7), and a
-physical particle radius [m], when known, sets the length scale. The dense suspension
-viscosity is not validated yet (README, Suspensions): the Einstein limit passes.
+physical particle radius [m], when known, sets the length scale. What the suspension
+viscosity is validated against, and where it falls short, is in the README (Suspensions).
 
 The run starts from the linear profile (``run.start = linear``): the step is then limited by
 μ(γ̇/2) rather than the zero-rate viscosity (:mod:`suspsim.sph.timestep`), which for a
