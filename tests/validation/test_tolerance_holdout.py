@@ -17,7 +17,10 @@ its cases and run with the packaged model of 2026-12-03; CPU seconds of one thre
   2 %: one attempt, W = 4.375 h, 1.08 %, nothing cheaper meets 2 % (W = 3.125 h: 2.26 %);
 - poiseuille_bingham2.5_3d, 10 % and 7 %: one attempt, W = 3.75 h, 4.70 %, the cheapest;
 - poiseuille_bingham9_3d, 10 %: one attempt, W = 6.25 h, C = 0.3, 5.90 %, ratio 1; 7 %: one
-  attempt, C = 0.2, 5.65 %, 6.76 s against 3.71 s for C = 0.4 (6.55 %): ratio 1.82;
+  attempt, C = 0.2, 5.65 %, 6.76 s against 3.71 s for C = 0.4 (6.55 %): ratio 1.82. The
+  picked run takes twice the steps of the cheapest, so the ratio is 2 less the set-up's share
+  and crosses the bound with the timing: a reduced CI run on 2026-12-06 (after retiming) read
+  5.78 s against 2.87 s, 2.01, so the case carries its known failure;
 - poiseuille_newtonian_re0.5_3d, 5 %: W = 2.5 h missed (6.14 %), W = 3.125 h met (4.61 %),
   ratio 1.64; 2 %: W = 3.75 h missed (3.19 %), W = 6.25 h met (1.61 %), 0.83 s; the blind run's
   comparison (capped at 12) found nothing cheaper, the full one (cap 40) found W = 5 h, C = 0.05
@@ -60,7 +63,8 @@ CASES = [
     ("poiseuille_bingham2.5_3d", 0.1, None),
     ("poiseuille_bingham2.5_3d", 0.07, None),
     ("poiseuille_bingham9_3d", 0.1, None),
-    ("poiseuille_bingham9_3d", 0.07, None),
+    ("poiseuille_bingham9_3d", 0.07, "2.0x the cheapest: C = 0.2 (twice the steps) where "
+                                     "C = 0.4 meets; 1.82 in the blind pass, 2.01 in CI"),
     ("poiseuille_newtonian_re0.5_3d", 0.05, None),
     ("poiseuille_newtonian_re0.5_3d", 0.02, "2.6x the cheapest: W = 3.75 h missed, then "
                                             "W = 6.25 h where W = 5 h at C = 0.05 meets"),
