@@ -360,8 +360,13 @@ def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall
                         matrix_viscosity_at_rate=matrix,
                         relative_viscosity=data["viscosity"] / matrix,
                         relative_viscosity_stderr=data["viscosity_stderr"] / matrix)
+            split = ""
             if scene.fluid.law.is_newtonian:
                 data.update(_batchelor_split(series, steady, scene.flow.shear_rate * matrix))
+                split = (f"; from the bodies' share {data['particle_relative_viscosity']:.4g}, "
+                         f"the fluid's error {data['fluid_stress_error']:+.3g}")
+            log.info("phi %.4g: relative viscosity %.4g ± %.2g%s", data["phi"],
+                     data["relative_viscosity"], data["relative_viscosity_stderr"], split)
     data["y"] = record.sums["y"]
     for name in PROFILE_NAMES:
         data[name] = record.sums[name] / record.n_profiles

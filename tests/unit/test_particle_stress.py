@@ -35,10 +35,14 @@ def test_particle_stress_is_the_stresslets_plus_lubrication():
     assert "particle_stress" not in fluid_alone.sample()
 
 
-def test_newtonian_run_splits_its_relative_viscosity(tmp_path):
+def test_newtonian_run_splits_its_relative_viscosity(tmp_path, caplog):
     """η_r = η_r^p + fluid_stress_error (batch means are linear); the series and both parts
-    are written with their units; a power-law matrix gets the series but no split."""
+    are written with their units, and the log names both; a power-law matrix gets the series
+    but no split."""
+    caplog.set_level("INFO", logger="suspsim.run")
     out = run_scene(tiny(NEWTONIAN), tmp_path / "newtonian.nc")
+    assert any("relative viscosity" in r.message and "the fluid's error" in r.message
+               for r in caplog.records)
     with xr.open_dataset(out) as run:
         assert run["particle_stress"].dims == ("time",)
         assert run["particle_stress"].attrs["units"] == run["shear_stress"].attrs["units"]
@@ -52,3 +56,4 @@ def test_newtonian_run_splits_its_relative_viscosity(tmp_path):
     with xr.open_dataset(out) as run:
         assert "particle_stress" in run and "relative_viscosity" in run
         assert "particle_relative_viscosity" not in run and "fluid_stress_error" not in run
+
