@@ -7,6 +7,7 @@ import xarray as xr
 from suspsim.run import run_scene
 from suspsim.scene import scene_from_dict
 from suspsim.sph.simulation import Simulation
+from suspsim.sph.terms.force_pass import VXY
 
 NEWTONIAN = {"law": "newtonian", "params": {"mu": 1.0}}
 POWER_LAW = {"law": "power_law", "params": {"K": 1.0, "n": 0.5}}
@@ -28,7 +29,7 @@ def test_particle_stress_is_the_stresslets_plus_lubrication():
     sim = Simulation(tiny(NEWTONIAN), threads=1)
     sim.advance(20)
     sample = sim.sample()
-    expected = -(sim._body_virial[3] + sim._lubrication_virial[3]) / sim.scene.volume
+    expected = -(sim._body_virial[VXY] + sim._lubrication_virial[VXY]) / sim.scene.volume
     assert sample["particle_stress"] == pytest.approx(expected, rel=1e-12)
     assert sample["particle_stress"] != 0.0
     fluid_alone = Simulation(tiny(NEWTONIAN, phi=0.0), threads=1)

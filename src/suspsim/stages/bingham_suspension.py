@@ -190,6 +190,7 @@ def suspension_scene(job: Mapping[str, Any], packing: str | os.PathLike | None,
     (None: the scene packs the same spheres itself)."""
     name, params = matrix_law(job["rate"], job["viscosity_ratio"], job["shear_rate"])
     spheres = particles(job)
+    numerics = {"shifting": AUTO_SHIFTING_NON_NEWTONIAN} if job["rate"] is None else {}
     return {"dimension": 3, "box": [float(job["box"])] * 3,
             "number_density": float(job["number_density"]),
             "fluid": {"law": name, "params": params},
@@ -197,8 +198,7 @@ def suspension_scene(job: Mapping[str, Any], packing: str | os.PathLike | None,
             "run": {"strain": float(job["strain"]), "transient": float(job["transient"]),
                     "start": "linear", "threads": int(threads)},
             "lattice": {"relax": True},
-            "numerics": {} if job["rate"] is not None else
-            {"shifting": AUTO_SHIFTING_NON_NEWTONIAN},
+            "numerics": numerics,
             "inclusions": {"phi": float(job["volume_fraction"]), "shape": spheres.shape,
                            "radius": spheres.radius, "min_gap": STUDY_MIN_GAP,
                            "seed": int(job["seed"]),
