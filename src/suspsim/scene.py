@@ -112,6 +112,7 @@ class NumericsSpec:
     wi_target: float
     shifting: float
     shifting_rate: float
+    shifting_at_bodies: str
     rate_smoothing: bool
     pressure_reference: str
     dt_viscous_coefficient: float

@@ -132,20 +132,25 @@ AUTO_SHIFTING_NON_NEWTONIAN = 3.0
 #: and hold the end values beyond. Stronger shifting resolves the squeeze to closer gaps, and a
 #: larger cutoff would count the resolved force twice.
 AUTO_CUTOFF_GAP_CORRECTED = ((3.0, 0.58), (30.0, 0.185), (100.0, 0.14))
+#: The same with shifting tangential at the bodies (numerics.shifting_at_bodies; make_squeeze.py
+#: --no-large --set numerics.shifting=A --set numerics.shifting_at_bodies='"tangential"').
+AUTO_CUTOFF_GAP_TANGENTIAL = ((3.0, 0.437), (30.0, 0.246), (100.0, 0.185))
 #: The same without the spin correction (A = 30; the resolved force stays within 10 % of
 #: Jeffrey–Onishi down to 0.58 h).
 AUTO_CUTOFF_GAP_UNCORRECTED = 0.6
 
 
 def _resolve_cutoff(inclusions: dict, numerics: dict) -> dict:
-    """``inclusions.lubrication.cutoff_gap`` auto → :data:`AUTO_CUTOFF_GAP_CORRECTED` at the
-    scene's shifting coefficient with the spin correction, else
-    :data:`AUTO_CUTOFF_GAP_UNCORRECTED`."""
+    """``inclusions.lubrication.cutoff_gap`` auto → :data:`AUTO_CUTOFF_GAP_CORRECTED` (or
+    :data:`AUTO_CUTOFF_GAP_TANGENTIAL` with shifting tangential at the bodies) at the scene's
+    shifting coefficient with the spin correction, else :data:`AUTO_CUTOFF_GAP_UNCORRECTED`."""
     lub = dict(inclusions["lubrication"])
     if lub["cutoff_gap"] == "auto":
         lub["cutoff_gap"] = AUTO_CUTOFF_GAP_UNCORRECTED
         if numerics["spin_correction"]:
-            lub["cutoff_gap"] = _log_interpolate(AUTO_CUTOFF_GAP_CORRECTED, numerics["shifting"])
+            table = (AUTO_CUTOFF_GAP_TANGENTIAL if numerics["shifting_at_bodies"] == "tangential"
+                     else AUTO_CUTOFF_GAP_CORRECTED)
+            lub["cutoff_gap"] = _log_interpolate(table, numerics["shifting"])
     lub["cutoff_gap"] = float(lub["cutoff_gap"])
     return {**inclusions, "lubrication": lub}
 
@@ -171,10 +176,12 @@ def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, newt
     ``terms.viscous.local_spin``); ``shifting`` auto → :data:`AUTO_SHIFTING_WITH_INCLUSIONS`
     with inclusions (:data:`AUTO_SHIFTING_NON_NEWTONIAN` in a non-Newtonian matrix), 0 without;
     ``shifting_rate`` auto → the imposed shear rate of a couette flow, 0 otherwise (shifting's
-    diffusivity is A h² γ_s δt, ``terms.shifting``); ``rate_smoothing`` auto → on where
-    shifting acts on a non-Newtonian fluid (``terms.rate_smoothing``); ``pressure_reference``
-    auto → fluid_mean where shifting acts (A > 0 and γ_s > 0), nominal elsewhere; an explicit fluid_mean where it
-    does not is refused (particles pair up, SPEC §2.3)."""
+    diffusivity is A h² γ_s δt, ``terms.shifting``); ``shifting_at_bodies`` auto → full
+    (``terms.shifting``: tangential is the option that strong shifting needs);
+    ``rate_smoothing`` auto → on where shifting acts on a non-Newtonian fluid
+    (``terms.rate_smoothing``); ``pressure_reference`` auto → fluid_mean where shifting acts
+    (A > 0 and γ_s > 0), nominal elsewhere; an explicit fluid_mean where it does not is refused
+    (particles pair up, SPEC §2.3)."""
     out = dict(numerics)
     if numerics["spin_correction"] == "auto":
         out["spin_correction"] = inclusions_present
@@ -187,6 +194,8 @@ def _resolve_numerics(numerics: dict, inclusions_present: bool, flow: dict, newt
     if numerics["shifting_rate"] == "auto":
         out["shifting_rate"] = float(flow["shear_rate"]) if flow["type"] == "couette" else 0.0
     out["shifting_rate"] = float(out["shifting_rate"])
+    if numerics["shifting_at_bodies"] == "auto":
+        out["shifting_at_bodies"] = "full"
     reference = numerics["pressure_reference"]
     shifting = out["shifting"] > 0.0 and out["shifting_rate"] > 0.0
     if numerics["rate_smoothing"] == "auto":

@@ -237,18 +237,24 @@ def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected)
     assert (fluid.numerics.shifting, fluid.numerics.pressure_reference) == (0.0, "nominal")
     assert suspension.numerics.shifting == expected
     assert suspension.numerics.pressure_reference == "fluid_mean"
+    assert (fluid.numerics.shifting_at_bodies, suspension.numerics.shifting_at_bodies) == (
+        "full", "full")
 
 
 @pytest.mark.parametrize("extra, spin, cutoff", [
     ("", True, 0.58), ("numerics: {shifting: 30}\n", True, 0.185),
     ("numerics: {shifting: 100}\n", True, 0.14), ("numerics: {shifting: 300}\n", True, 0.14),
     ("numerics: {shifting: 10}\n", True, 0.319),
+    ("numerics: {shifting: 100, shifting_at_bodies: tangential}\n", True, 0.185),
+    ("numerics: {shifting_at_bodies: tangential}\n", True, 0.437),
+    ("numerics: {shifting: 10, shifting_at_bodies: tangential}\n", True, 0.324),
     ("numerics: {spin_correction: false, shifting: 30}\n", False, 0.6)])
 def test_spin_correction_and_cutoff_auto_follow_the_squeeze_calibration(tmp_path, extra, spin,
                                                                        cutoff):
     """The correction is on with bodies only; the auto cutoff is the calibrated gap at the
-    scene's shifting coefficient (A = 3 auto in this non-Newtonian matrix), interpolated in
-    log A between the measured 3, 30 and 100; an explicit cutoff stays."""
+    scene's shifting coefficient (A = 3 auto in this non-Newtonian matrix) and its shifting at
+    the bodies (full or tangential), interpolated in log A between the measured 3, 30 and 100;
+    an explicit cutoff stays."""
     fluid = load_scene(_write(tmp_path, MINIMAL + extra))
     suspension = load_scene(_write(tmp_path, MINIMAL + extra
                                    + "inclusions: {phi: 0.1, radius: 2.0}\n"))

@@ -50,7 +50,7 @@ from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbo
                                     build_neighbour_list, needs_rebuild, raise_for_code,
                                     rebuild_neighbour_list, sort_by_cell)
 from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
-from suspsim.sph.terms.force_pass import VXY, force_width
+from suspsim.sph.terms.force_pass import VXY, concentration_column, force_width
 from suspsim.sph.terms.shifting import shift_particles
 from suspsim.sph.terms.velocity_pass import GRADIENT_WIDTH
 from suspsim.sph.terms.viscous import bulk_factor, viscous_weights
@@ -159,6 +159,8 @@ class Simulation:
         # Shifting acts only with a rate scale (numerics.shifting_rate; auto: the imposed rate).
         self._shifting_rate = float(scene.numerics.shifting_rate)
         self._shifting = float(scene.numerics.shifting) if self._shifting_rate > 0.0 else 0.0
+        self._tangential_shift = (self.bodies is not None
+                                  and scene.numerics.shifting_at_bodies == "tangential")
         self._mean_reference = scene.numerics.pressure_reference == "fluid_mean"
         self._smooth_rate = bool(scene.numerics.rate_smoothing)
         if _state is None:
@@ -260,7 +262,7 @@ class Simulation:
         gradient pass's, :func:`~suspsim.sph.terms.force_pass.force_width` values per particle
         for the current bulk-gradient and shifting settings."""
         n, rows = self.n_particles, self._scratch_15.shape[0]
-        width = force_width(self._bulk_gradient, self._shifting > 0.0)
+        width = force_width(self._bulk_gradient, self._shifting > 0.0, self._tangential_shift)
         self._force_width = width
         self._force_acc = self._grad_acc[:n * width]
         self._pressure = self._grad_acc[width * n:(width + 1) * n]
@@ -492,7 +494,8 @@ class Simulation:
                 self._place_bodies(rotations, bodies.velocities, bodies.angular_velocities(),
                                    time, self._v)
             if self._shifting > 0.0:
-                shift_particles(self._force_acc, self._body_of, self._shifting,
+                shift_particles(self._force_acc, concentration_column(self._bulk_gradient),
+                                self._tangential_shift, self._body_of, self._shifting,
                                 self._shifting_rate, dt, SUPPORT, self._gradient, self._x,
                                 self._v)
             if self._mean_reference:

@@ -34,8 +34,9 @@ and 0.35 ms beside the bulk gradient's sums (φ = 0.4 benchmark suspensions, two
 inside one body are skipped here, which changes ∇C only on body particles, which do not shift.
 
 The accumulator holds per particle the force (3), then the ∇a sums (3) with the bulk
-gradient, then ∇C (3) with shifting (:func:`force_width`): the plain fluid scatters 3 values
-per pair end, not 9.
+gradient, then ∇C (3) with shifting, then ∇C_b = −Σ_{j ∈ bodies} V_j F r_ij (3), the bodies'
+part of ∇C, where shifting is tangential at bodies (:func:`force_width`): the plain fluid
+scatters 3 values per pair end, not 12.
 
 The virial Σ_pairs f_ij,a r_ij,b (½ Σ_i Σ_j of SPEC §2.8 over the half table) is summed per
 chunk into ``virial[c]`` = (xx, yy, zz, xy, yx); ``stress`` turns it into Π and σ = −Π.
@@ -59,10 +60,16 @@ from suspsim.sph.terms.viscous import (explicit_bulk_term, pair_viscosity, parti
                                       without_rotation)
 
 
-def force_width(bulk_gradient: bool, shifting: bool) -> int:
+def force_width(bulk_gradient: bool, shifting: bool, body_normal: bool = False) -> int:
     """Values per particle in the force accumulator: force (3), Σ V_j F (a_i − a_j) r (3) with
-    the bulk gradient, ∇C (3) with shifting (the last three columns)."""
-    return 3 + 3 * bool(bulk_gradient) + 3 * bool(shifting)
+    the bulk gradient, ∇C (3) with shifting, then ∇C_b (3), the bodies' part of ∇C, with
+    ``body_normal`` (shifting tangential at bodies, ``terms.shifting``)."""
+    return 3 + 3 * bool(bulk_gradient) + 3 * bool(shifting) + 3 * bool(shifting and body_normal)
+
+
+def concentration_column(bulk_gradient: bool) -> int:
+    """The accumulator's first ∇C column (:func:`force_width`); ∇C_b follows it."""
+    return 3 + 3 * bool(bulk_gradient)
 
 
 #: Columns of a chunk's virial row.
@@ -77,8 +84,11 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
     lo..hi−1, both ends; virial_row +=."""
     n = volume.shape[0]
     width = acc.shape[0] // n
-    concentration = width > (6 if bulk_gradient else 3)
-    c0 = width - 3
+    # The start's relaxation turns the bulk gradient off in the run's wider accumulator; it does
+    # not shift, so wherever ∇C lands then is scratch.
+    c0 = 6 if bulk_gradient else 3
+    concentration = width > c0
+    body_normal = width > c0 + 3
     sums = acc.reshape((n, width))
     sxx = syy = szz = sxy = syx = 0.0
     for i in range(lo, hi):
@@ -158,6 +168,14 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
                 sums[j, c0] += ci * dx
                 sums[j, c0 + 1] += ci * dy
                 sums[j, c0 + 2] += ci * dz
+                if body_normal and body_i < 0 <= body_j:
+                    sums[i, c0 + 3] -= cj * dx
+                    sums[i, c0 + 4] -= cj * dy
+                    sums[i, c0 + 5] -= cj * dz
+                elif body_normal and body_j < 0 <= body_i:
+                    sums[j, c0 + 3] += ci * dx
+                    sums[j, c0 + 4] += ci * dy
+                    sums[j, c0 + 5] += ci * dz
         sums[i, 0] += fxi
         sums[i, 1] += fyi
         sums[i, 2] += fzi
