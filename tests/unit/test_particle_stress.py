@@ -57,4 +57,3 @@ def test_newtonian_run_splits_its_relative_viscosity(tmp_path, caplog):
     with xr.open_dataset(out) as run:
         assert "particle_stress" in run and "relative_viscosity" in run
         assert "particle_relative_viscosity" not in run and "fluid_stress_error" not in run
-

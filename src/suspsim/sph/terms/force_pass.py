@@ -60,16 +60,18 @@ from suspsim.sph.terms.viscous import (explicit_bulk_term, pair_viscosity, parti
                                       without_rotation)
 
 
+@njit(inline="always", **JIT_OPTIONS)
+def concentration_column(bulk_gradient):
+    """The accumulator's first ∇C column (:func:`force_width`); ∇C_b follows it."""
+    return 6 if bulk_gradient else 3
+
+
 def force_width(bulk_gradient: bool, shifting: bool, body_normal: bool = False) -> int:
     """Values per particle in the force accumulator: force (3), Σ V_j F (a_i − a_j) r (3) with
     the bulk gradient, ∇C (3) with shifting, then ∇C_b (3), the bodies' part of ∇C, with
     ``body_normal`` (shifting tangential at bodies, ``terms.shifting``)."""
-    return 3 + 3 * bool(bulk_gradient) + 3 * bool(shifting) + 3 * bool(shifting and body_normal)
-
-
-def concentration_column(bulk_gradient: bool) -> int:
-    """The accumulator's first ∇C column (:func:`force_width`); ∇C_b follows it."""
-    return 3 + 3 * bool(bulk_gradient)
+    return (concentration_column(bool(bulk_gradient)) + 3 * bool(shifting)
+            + 3 * bool(shifting and body_normal))
 
 
 #: Columns of a chunk's virial row.
@@ -86,7 +88,7 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
     width = acc.shape[0] // n
     # The start's relaxation turns the bulk gradient off in the run's wider accumulator; it does
     # not shift, so wherever ∇C lands then is scratch.
-    c0 = 6 if bulk_gradient else 3
+    c0 = concentration_column(bulk_gradient)
     concentration = width > c0
     body_normal = width > c0 + 3
     sums = acc.reshape((n, width))
