@@ -190,7 +190,7 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
         sim._alpha, sim._beta, sim._bulk_factor, sim._bulk_gradient, shear_ly, sim._body_of,
         sim._body_spin, sim._spin_correction,
         spin_bulk_coefficient(sim._spin_correction, sim.scene.dimension), sim._gradient,
-        sim._pressure, sim._force_acc, sim._force_scratch, sim._bounds, sim._virial)
+        sim._pressure, sim._spin, sim._force_acc, sim._force_scratch, sim._bounds, sim._virial)
     calls["force finish"] = lambda: force_finish(
         sim._force_acc, sim._x, sim._rho, sim._inverse_moment, sim._gradient, sim._mass,
         sim._bulk_gradient, sim._body_force, box[1], sim._a_new)

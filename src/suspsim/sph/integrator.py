@@ -73,7 +73,7 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
                   law_params, newtonian, velocity_gradient, smooth_rate, normalise,
                   normalisation_interval, normalisation_age, alpha, beta,
                   bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, spin_correction,
-                  rho, volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
+                  rho, volume, pressure, spin, pair_start, pair_end, pair_j, geometry, pair_cross,
                   pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
                   viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
                   scratch_15, force_scratch, bounds, virial, accel_out):
@@ -97,8 +97,9 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     inverse moment are 0 and the normalisation keeps their μ̂ (``velocity_pass``).
     ``spin_correction`` (``numerics.spin_correction``, which needs ``velocity_gradient``)
     takes the β term of fluid–fluid pairs relative to the particles' local spin
-    (``terms.viscous.local_spin``), normalises by the strain rate alone and removes its bulk
-    viscosity through the pressure (``terms.viscous.spin_bulk_pressure``).
+    (``terms.viscous.local_spin``; ``spin`` (N, 3) scratch holds each particle's), normalises
+    by the strain rate alone and removes its bulk viscosity through the pressure
+    (``terms.viscous.spin_bulk_pressure``).
     """
     shear_ly = shear_rate * box[1]
     code = summation_density(positions, box, offset, nl_start, nl_image_start, nl_neighbours,
@@ -138,8 +139,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
     force_sums(pair_start, pair_end, pair_j, geometry, pair_cross, pair_image, predicted, rho,
                volume, viscosity_hat, mass, rho_eq, c2, alpha, beta, bulk_factor, bulk_gradient,
                shear_ly, body_of, body_spin, spin_correction,
-               spin_bulk_coefficient(spin_correction, dimension), gradient, pressure, force_acc,
-               force_scratch, bounds, virial)
+               spin_bulk_coefficient(spin_correction, dimension), gradient, pressure, spin,
+               force_acc, force_scratch, bounds, virial)
     force_finish(force_acc, positions, rho, inverse_moment, gradient, mass, bulk_gradient,
                  body_force, box[1], accel_out)
     return TABLE_OK
@@ -152,7 +153,7 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta,
                   bulk_factor, bulk_gradient, has_bodies, body_of, body_spin, spin_correction,
-                  rho, volume, pressure, pair_start, pair_end, pair_j, geometry, pair_cross,
+                  rho, volume, pressure, spin, pair_start, pair_end, pair_j, geometry, pair_cross,
                   pair_image, gradient, inverse_moment, moment_trace, strain, dissipation, gdot,
                   viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
                   scratch_15, force_scratch, bounds, virial):
@@ -177,12 +178,11 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
             positions, predicted, box, offset, nl_start, nl_image_start, nl_neighbours, kernel, h,
             mass, rho_eq, c2, shear_rate, body_force, dimension, law_code, law_params, newtonian,
             velocity_gradient, smooth_rate, normalise, normalisation_interval, normalisation_age,
-            alpha, beta, bulk_factor, bulk_gradient,
-            has_bodies, body_of, body_spin, spin_correction, rho, volume, pressure, pair_start,
-            pair_end, pair_j,
-            geometry, pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain,
-            dissipation, gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc,
-            scratch_1, scratch_15, force_scratch, bounds, virial, accel_new)
+            alpha, beta, bulk_factor, bulk_gradient, has_bodies, body_of, body_spin,
+            spin_correction, rho, volume, pressure, spin, pair_start, pair_end, pair_j, geometry,
+            pair_cross, pair_image, gradient, inverse_moment, moment_trace, strain, dissipation,
+            gdot, viscosity, factor, viscosity_hat, grad_acc, diss_acc, force_acc, scratch_1,
+            scratch_15, force_scratch, bounds, virial, accel_new)
         if code != TABLE_OK:
             return done, GROW_TABLE
         kick(velocities, accel, accel_new, dt)

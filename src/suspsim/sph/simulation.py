@@ -233,9 +233,9 @@ class Simulation:
         self._moment_trace = np.zeros(n)
         # The passes' accumulators and chunk buffers live one pass each (density → body
         # density → gradient → smoothing → dissipation → force → body forces → shifting, one
-        # after the other), so the narrower ones, and the force pass's pressure scratch, are
-        # views of the 15-wide ones: 176 bytes per particle and chunk fewer. The force sums
-        # stay readable until the next step (bodies and shifting read them).
+        # after the other), so the narrower ones, and the force pass's pressure and spin
+        # scratch, are views of the 15-wide ones: 176 bytes per particle and chunk fewer. The
+        # force sums stay readable until the next step (bodies and shifting read them).
         self._grad_acc = np.zeros(n * GRADIENT_WIDTH)
         self._diss_acc = self._grad_acc[(GRADIENT_WIDTH - 1) * n:]
         self._scratch_15 = np.zeros((t - 1, n * GRADIENT_WIDTH))
@@ -266,6 +266,9 @@ class Simulation:
         self._force_width = width
         self._force_acc = self._grad_acc[:n * width]
         self._pressure = self._grad_acc[width * n:(width + 1) * n]
+        # The spin correction holds no bulk gradient, so its width leaves room for the spins.
+        spins = self._grad_acc[(width + 1) * n:(width + 4) * n]
+        self._spin = spins.reshape(n, 3) if spins.shape[0] == 3 * n else np.zeros((n, 3))
         self._force_scratch = self._scratch_15.reshape(-1)[:rows * n * width].reshape(
             rows, n * width)
 
@@ -340,8 +343,8 @@ class Simulation:
                 self.scene.numerics.normalisation_interval, self._normalisation_age, self._alpha,
                 self._beta, self._bulk_factor, self._bulk_gradient, self.bodies is not None,
                 self._body_of, self._body_spin, self._spin_correction, self._rho, self._volume,
-                self._pressure, tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry,
-                tb.pair_cross, tb.pair_image, self._gradient,
+                self._pressure, self._spin, tb.pair_start, tb.pair_end, tb.pair_j,
+                tb.pair_geometry, tb.pair_cross, tb.pair_image, self._gradient,
                 self._inverse_moment, self._moment_trace, self._strain, self._dissipation,
                 self._gdot, self._mu, self._factor, self._mu_hat, self._grad_acc,
                 self._diss_acc, self._force_acc, self._scratch_1, self._scratch_15,

@@ -42,7 +42,7 @@ def _force_pass(cloud, width, bulk_gradient, body_of, chunks=1):
     force_sums(start, start[1:], js, rows, start[1:].copy(), np.zeros(len(js), dtype=np.int64),
                v, rho, volume, np.linspace(0.5, 1.5, N), 1.0, 4.0, 4.0, alpha, beta,
                -5.0 / 3.0, bulk_gradient, 0.0, body_of, np.zeros((1, 3)), False, 0.0,
-               np.zeros((N, 9)), np.zeros(N), acc,
+               np.zeros((N, 9)), np.zeros(N), np.zeros((N, 3)), acc,
                np.zeros((chunks - 1, width * N)), bounds, np.zeros((chunks, 5)))
     return acc.reshape(N, width)
 

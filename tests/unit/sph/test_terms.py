@@ -63,8 +63,8 @@ def _two_particle_force(body_of, viscosity, velocity=((0.1, -0.2, 0.05), (0.0, 0
                np.array([1, 1]), np.zeros(1, dtype=np.int64), velocity, np.full(2, 4.0),
                np.full(2, 0.25), np.asarray(viscosity, dtype=float), 1.0, 4.0, 0.0, alpha,
                beta, -5.0 / 3.0, False, 0.0, np.asarray(body_of), np.asarray(spin, dtype=float),
-               correction, 0.0, gradient, np.zeros(2), acc, np.zeros((0, 2 * width)),
-               np.array([0, 2]), np.zeros((1, 5)))
+               correction, 0.0, gradient, np.zeros(2), np.zeros((2, 3)), acc,
+               np.zeros((0, 2 * width)), np.array([0, 2]), np.zeros((1, 5)))
     return acc.reshape(2, width)[:, :3] if both_ends else acc[:3]
 
 
