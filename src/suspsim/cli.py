@@ -4,7 +4,8 @@ Also ``suspsim run SCENE.yaml --out RUN.nc [--resume] [--threads N] [--tolerance
 [--no-verify]]`` (an SPH run, see :mod:`suspsim.run`, or a DST run of a wyart_cates scene, see
 :mod:`suspsim.dst.run`; ``--tolerance`` chooses the numerics from the error model and checks
 the runs against the exact solution, :mod:`suspsim.convergence.tolerance`),
-``suspsim bench [--scene NAME] [--threads N] [--steps K] [--particles N] [--json]`` and
+``suspsim bench [--scene NAME] [--threads N] [--steps K] [--particles N] [--against-fluid
+[--rounds R]] [--json]`` and
 ``suspsim pack --shape sphere|sand --phi PHI --radius A --box LX LY LZ --out PACK.nc
 [--polydispersity S] [--seed N] ...`` (a random packing, see :mod:`suspsim.bodies.packing`).
 
@@ -82,6 +83,12 @@ def _build_parser() -> argparse.ArgumentParser:
                        help="lattice sites of the box, a cube k^3 (box side k/1.6 h; default: "
                        "32768, the 20 h box; dst-2d: about this many fluid particles); for "
                        "the scaling with N")
+    bench.add_argument("--against-fluid", action="store_true", help="time each suspension "
+                       "scene against its fluid in one process, alternating --rounds slices "
+                       "of the --steps, and report the cost of a step per particle relative "
+                       "to the fluid's")
+    bench.add_argument("--rounds", type=_positive_int, default=10, help="slices of "
+                       "--against-fluid (default: 10)")
     bench.add_argument("--json", action="store_true", help="print one JSON object per scene")
 
     pack = sub.add_parser("pack", help="pack random non-overlapping spheres or sand grains in a "
@@ -216,12 +223,30 @@ def _value(result, name: str) -> str:
 def _cmd_bench(args) -> int:
     import json
 
-    from .sph.bench import benchmark
+    from .sph.bench import SUSPENDING_FLUID, benchmark, paired_cost
 
     if args.threads is None:
         import numba
 
         args.threads = numba.config.NUMBA_NUM_THREADS
+    if args.against_fluid:
+        if args.rounds > args.steps:
+            raise InputError("--rounds", f"{args.rounds} exceeds --steps {args.steps}: each "
+                             "round times at least one step")
+        if args.scene not in (None, *SUSPENDING_FLUID):
+            raise InputError("--scene", f"--against-fluid takes a suspension scene "
+                             f"({', '.join(SUSPENDING_FLUID)}), not {args.scene}")
+        scenes = [args.scene] if args.scene else list(SUSPENDING_FLUID)
+        for name in scenes:
+            result = paired_cost(name, args.steps, args.threads, args.rounds, args.particles)
+            print(json.dumps(result) if args.json else
+                  f"{name}: a step per particle costs {result['cost_ratio']:.2f} x "
+                  f"{result['fluid']}'s ({result['threads']} thread(s), {result['steps']} "
+                  f"steps each in {result['rounds']} alternating slices; slices "
+                  f"{min(result['slice_ratios']):.2f}-{max(result['slice_ratios']):.2f}; "
+                  f"{result['particle_steps_per_s']:.3g} against "
+                  f"{result['fluid_particle_steps_per_s']:.3g} particle-steps/s)", flush=True)
+        return 0
     results = []
     for name in [args.scene] if args.scene else BENCH_SCENES:
         result = benchmark(name, args.steps, args.threads, args.particles)

@@ -10,7 +10,7 @@ import pytest
 
 import suspsim.run as run_module
 from suspsim.cli import main
-from suspsim.sph.bench import lattice_side
+from suspsim.sph.bench import SUSPENDING_FLUID, lattice_side, paired_cost
 from suspsim.io.netcdf import read_run
 from test_run_loop import FakeSimulation, fake
 
@@ -92,8 +92,9 @@ def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
                 "steps": n_steps, "wall_time_s": 0.5,
                 "particle_steps_per_s": particles * n_steps / 0.5, "rebuilds": 3}
 
-    monkeypatch.setitem(sys.modules, "suspsim.sph.bench",
-                        types.SimpleNamespace(benchmark=benchmark, lattice_side=lattice_side))
+    monkeypatch.setitem(sys.modules, "suspsim.sph.bench", types.SimpleNamespace(
+        benchmark=benchmark, lattice_side=lattice_side, paired_cost=None,
+        SUSPENDING_FLUID=SUSPENDING_FLUID))
     assert main(["-q", "bench", "--steps", "10"]) == 0
     table = capsys.readouterr().out.splitlines()
     assert len(table) == 7 and "particle-steps/s" in table[0] and "6.55e+05" in table[1]
@@ -112,6 +113,51 @@ def test_bench_table_and_json_with_a_fake_benchmark(monkeypatch, capsys):
         main(["-q", "bench", "--particles", "30000"])
     assert stop.value.code == 1 and "cube k^3" in capsys.readouterr().err
     assert len(calls) == before
+
+
+def test_bench_against_fluid_with_a_fake_pairing(monkeypatch, capsys):
+    calls = []
+
+    def paired_cost(scene_name, n_steps, threads, rounds, particles):
+        calls.append((scene_name, n_steps, threads, rounds, particles))
+        return {"scene": scene_name, "fluid": SUSPENDING_FLUID[scene_name], "threads": threads,
+                "steps": n_steps, "rounds": rounds, "cost_ratio": 1.4,
+                "slice_ratios": [1.3, 1.5], "particle_steps_per_s": 2.0e6,
+                "fluid_particle_steps_per_s": 2.8e6}
+
+    monkeypatch.setitem(sys.modules, "suspsim.sph.bench", types.SimpleNamespace(
+        paired_cost=paired_cost, benchmark=None, lattice_side=lattice_side,
+        SUSPENDING_FLUID=SUSPENDING_FLUID))
+    assert main(["-q", "bench", "--against-fluid", "--threads", "1", "--steps", "20",
+                 "--rounds", "2"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [c[0] for c in calls] == ["suspension-newtonian", "suspension-papanastasiou"]
+    assert calls[0][1:4] == (20, 1, 2)
+    assert lines[0].startswith("suspension-newtonian: a step per particle costs 1.40 x "
+                               "fluid-newtonian's") and "slices 1.30-1.50" in lines[0]
+    assert main(["-q", "bench", "--against-fluid", "--scene", "suspension-papanastasiou",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["fluid"] == "fluid-papanastasiou"
+    for argv, problem in ((["--scene", "fluid-newtonian"], "takes a suspension scene"),
+                          (["--steps", "5", "--rounds", "6"], "exceeds --steps 5")):
+        assert main(["-q", "bench", "--against-fluid", *argv]) == 1
+        assert problem in capsys.readouterr().err
+    assert len(calls) == 3
+
+
+def test_paired_cost_alternates_both_scenes_in_one_process():
+    """A small box: the suspension and its fluid each advance their share of the steps in
+    every round; the ratio is the suspension's time per particle-step over the fluid's."""
+    result = paired_cost("suspension-newtonian", 6, 1, 3, particles=8000)
+    assert result["fluid"] == "fluid-newtonian" and result["rounds"] == 3
+    assert len(result["slice_ratios"]) == 3 and all(r > 0 for r in result["slice_ratios"])
+    assert result["n_particles"] != result["fluid_n_particles"] == 8000
+    assert result["cost_ratio"] == pytest.approx(
+        result["fluid_particle_steps_per_s"] / result["particle_steps_per_s"], rel=1e-12)
+    assert min(result["slice_ratios"]) <= result["cost_ratio"] * (1 + 1e-12)
+    assert result["cost_ratio"] <= max(result["slice_ratios"]) * (1 + 1e-12)
+    with pytest.raises(ValueError, match="not a suspension scene"):
+        paired_cost("fluid-newtonian", 6, 1, 3)
 
 
 def test_bench_dst_scene_json(tmp_path):

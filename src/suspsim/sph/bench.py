@@ -24,7 +24,9 @@ of side k/1.6 h for the scaling with N (``suspsim bench --particles``). Scenes:
 
 :func:`benchmark` times ``n_steps`` steps after :data:`WARM_UP` untimed steps and
 reports particle-steps per second (N × steps / wall time), neighbour-list rebuilds included,
-and the error reached (see :func:`benchmark`).
+and the error reached (see :func:`benchmark`). :func:`paired_cost` (``suspsim bench
+--against-fluid``) times a suspension scene against its fluid in one process, alternating
+slices of steps, so that a shared machine's changing load falls on both.
 """
 from __future__ import annotations
 
@@ -64,6 +66,10 @@ SCENES = {
                                   "params": {"mu_pl": 0.01, "mu_0": 0.99, "M": 100.0}}, 0.01,
                                  {"phi": 0.4, "radius": 2.5}),
 }
+
+#: Each suspension scene and the fluid it is suspended in (:func:`paired_cost`).
+SUSPENDING_FLUID = {"suspension-newtonian": "fluid-newtonian",
+                    "suspension-papanastasiou": "fluid-papanastasiou"}
 
 
 def lattice_side(particles: int) -> float:
@@ -195,3 +201,45 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
         sim._force_acc, sim._x, sim._rho, sim._inverse_moment, sim._gradient, sim._mass,
         sim._bulk_gradient, sim._body_force, box[1], sim._a_new)
     return best_times(calls, repeats)
+
+
+def paired_cost(scene_name: str, n_steps: int, threads: int, rounds: int,
+                particles: int = PARTICLES) -> dict:
+    """A step per particle of the suspension scene ``scene_name`` against one of its fluid
+    (:data:`SUSPENDING_FLUID`): both simulations are built and warmed up (:data:`WARM_UP`
+    steps), then ``rounds`` times each advances ``n_steps``/``rounds`` steps, one after the
+    other, each slice timed. Single runs a few seconds apart moved by ±10–25 % on a shared
+    2-core machine; slices a fraction of a second apart see the same load.
+
+    Returns {scene, fluid, n_particles, fluid_n_particles, threads, steps, rounds,
+    cost_ratio (the suspension's wall time per particle-step over the fluid's, all slices
+    summed), slice_ratios (the same per round), particle_steps_per_s,
+    fluid_particle_steps_per_s}.
+    """
+    try:
+        fluid_name = SUSPENDING_FLUID[scene_name]
+    except KeyError:
+        raise ValueError(f"{scene_name!r} is not a suspension scene; known: "
+                         f"{', '.join(SUSPENDING_FLUID)}") from None
+    threads = int(min(threads, numba.config.NUMBA_NUM_THREADS))
+    sims = [Simulation(benchmark_scene(name, particles), threads=threads)
+            for name in (fluid_name, scene_name)]
+    for sim in sims:
+        sim.advance(WARM_UP)
+    walls = np.zeros((rounds, 2))
+    steps = np.diff(np.linspace(0, n_steps, rounds + 1).astype(int))
+    for k in range(rounds):
+        for s, sim in enumerate(sims):
+            start = time.perf_counter()
+            sim.advance(int(steps[k]))
+            walls[k, s] = time.perf_counter() - start
+    counts = np.array([sim.n_particles for sim in sims], dtype=float)
+    per_particle_step = walls / (counts * steps[:, None])
+    total = walls.sum(axis=0) / (counts * n_steps)
+    return {"scene": scene_name, "fluid": fluid_name, "n_particles": sims[1].n_particles,
+            "fluid_n_particles": sims[0].n_particles, "threads": threads,
+            "steps": int(n_steps), "rounds": int(rounds),
+            "cost_ratio": float(total[1] / total[0]),
+            "slice_ratios": (per_particle_step[:, 1] / per_particle_step[:, 0]).tolist(),
+            "particle_steps_per_s": float(1.0 / total[1]),
+            "fluid_particle_steps_per_s": float(1.0 / total[0])}
