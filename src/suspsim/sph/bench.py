@@ -205,11 +205,11 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
 
 def paired_cost(scene_name: str, n_steps: int, threads: int, rounds: int,
                 particles: int = PARTICLES) -> dict:
-    """A step per particle of the suspension scene ``scene_name`` against one of its fluid
-    (:data:`SUSPENDING_FLUID`): both simulations are built and warmed up (:data:`WARM_UP`
-    steps), then ``rounds`` times each advances ``n_steps``/``rounds`` steps, one after the
-    other, each slice timed. Single runs a few seconds apart moved by ±10–25 % on a shared
-    2-core machine; slices a fraction of a second apart see the same load.
+    """The cost of a step per particle of the suspension scene ``scene_name`` against its
+    fluid's (:data:`SUSPENDING_FLUID`): both simulations are built and warmed up
+    (:data:`WARM_UP` steps), then ``rounds`` times each advances ``n_steps``/``rounds`` steps,
+    one after the other, each slice timed (single runs seconds apart moved by ±10–25 % on a
+    shared 2-core machine).
 
     Returns {scene, fluid, n_particles, fluid_n_particles, threads, steps, rounds,
     cost_ratio (the suspension's wall time per particle-step over the fluid's, all slices
