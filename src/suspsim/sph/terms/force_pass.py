@@ -112,7 +112,8 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
         n_plain = pair_cross[i] - first
         for k in range(js.shape[0]):
             j = js[k]
-            if body_i >= 0 and body_of[j] == body_i:
+            body_j = body_of[j]
+            if body_i >= 0 and body_j == body_i:
                 continue
             dx, dy, dz, f = rows[k, 0], rows[k, 1], rows[k, 2], rows[k, 3]
             r2 = dx * dx + dy * dy + dz * dz
@@ -124,7 +125,6 @@ def _force_loop(lo, hi, start, pair_end, pair_j, geometry, pair_cross, pair_imag
             vol_j = volume[j]
             kp = pressure_pair(p_i, pressure[j], f)
             mu_a, mu_b = mu_i, viscosity[j]
-            body_j = body_of[j]
             if spin_correction:
                 vx, vy, vz = without_rotation(0.5 * (oxi + spin[j, 0]), 0.5 * (oyi + spin[j, 1]),
                                               0.5 * (ozi + spin[j, 2]), dx, dy, dz, vx, vy, vz)

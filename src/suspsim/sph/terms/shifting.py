@@ -19,14 +19,11 @@ bodies' own concentration, which points into the nearest body: the fluid is spre
 surface but not moved across it, as Lind et al. treat a free surface [choice]. Why: shifting
 across the surface layer slows the body's coupling to the fluid, more the larger A (each
 shifted particle takes the interpolated velocity of where it lands, and beside a rigid shell
-that interpolation is one-sided): a torque-free sphere (a = 2.5 h, φ = 0.03, strain 1 + 4,
-``docs/figures/make_sphere_spin.py``) turned at 0.919 × γ̇/2 at A = 100 with full shifting
-and 1.010 tangential (1.018 and 0.984 at A = 30); four runs of the tangential setting read
-0.928–1.010 (mean 0.978), one of full shifting 0.919, so the gain is about 6 %, with that
-scatter. Tangential shifting lets A = 100 relax the fluid's structure (below) without
-slowing the bodies as much: one sphere then reads Einstein's
-[η] = 2.34 from its total stress (3.51 at the default A = 30). It is an option, not the
-default, until the two-sphere squeeze calibration holds at A = 100 (``scene_rules``).
+that interpolation is one-sided): at A = 100 a torque-free sphere turned at 0.919 × γ̇/2 with
+full shifting and at 0.928–1.010 (four runs) tangential, and one sphere's total stress gives
+Einstein's [η] = 2.34 (3.51 at the default A = 30; docs/suspensions.md, 2026-12-06). It is an
+option, not the default, until the two-sphere squeeze calibration holds at A = 100
+(``scene_rules``).
 
 Why: a disordered SPH fluid under shear builds up an anisotropic particle structure whose
 pressure forces add an elastic-like shear stress. Measured (Newtonian, n = 4.096 h⁻³, 7.5 h box,
