@@ -47,8 +47,8 @@ from suspsim.sph.integrator import (GROW_TABLE, REBUILD, accelerations, advance_
                                     kick, predict)
 from suspsim.sph.lattice import imposed_velocity, initial_velocities, lattice_positions
 from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbour_list,
-                                    build_neighbour_list, needs_rebuild, raise_for_code,
-                                    rebuild_neighbour_list, sort_by_cell)
+                                    build_neighbour_list, list_outdated, needs_rebuild,
+                                    raise_for_code, rebuild_neighbour_list, sort_by_cell)
 from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
 from suspsim.sph.terms.force_pass import VXY, concentration_column, force_width
 from suspsim.sph.terms.shifting import shift_particles
@@ -467,27 +467,30 @@ class Simulation:
     def _advance_python(self, n_steps: int) -> None:
         """The step of :mod:`~suspsim.sph.integrator` with rigid bodies or shifting (module
         docstrings of ``integrator``, ``bodies.system``, ``terms.shifting``): drift fluid and
-        bodies, place the body particles, rebuild if needed, predict, place with the predicted
-        body motion, forces, kick both, lubrication, shift; with the fluid_mean pressure
-        reference ρ_0 becomes the step's mean fluid density (used from the next step on)."""
+        bodies, predict, place the body particles with the predicted body motion, rebuild if
+        needed (and predict and place again), forces, kick both, lubrication, shift; with the
+        fluid_mean pressure reference ρ_0 becomes the step's mean fluid density (used from the
+        next step on)."""
         bodies, dt = self.bodies, self.dt
         for _ in range(n_steps):
             time = (self.step_count + 1) * self.dt
             drift(self._x, self._v, self._a, dt)
+            predict(self._v, self._a, dt, self._v_pred)
             if bodies is not None:
                 bodies.drift(dt)
                 # Orientations change only in the drift: one set of rotations for the step.
                 rotations = bodies.rotations()
                 predicted = bodies.predicted(dt)
-                # Positions for the rebuild test; the velocities written here are replaced.
-                self._place_bodies(rotations, *predicted, time, self._v)
-            nl = self._nlist
-            if needs_rebuild(self._x, self._reference, self._rate * (time - self._build_time),
-                             nl.cutoff, nl.skin, 0.5 * self._box[1]):
-                self._rebuild(time)
-            predict(self._v, self._a, dt, self._v_pred)
-            if bodies is not None:
                 self._place_bodies(rotations, *predicted, time, self._v_pred)
+            nl = self._nlist
+            if list_outdated(self._x, self._reference, self._rate * (time - self._build_time),
+                             nl.cutoff, nl.skin, 0.5 * self._box[1], self._box,
+                             self._offset(time), nl.start, nl.neighbours, self._body_of):
+                self._rebuild(time)
+                # The rebuild wrapped and reordered x, v and a, not ṽ.
+                predict(self._v, self._a, dt, self._v_pred)
+                if bodies is not None:
+                    self._place_bodies(rotations, *predicted, time, self._v_pred)
             self._compute_accelerations(self._v_pred, self._a_new, time)
             kick(self._v, self._a, self._a_new, dt)
             if bodies is not None:

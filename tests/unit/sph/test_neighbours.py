@@ -234,6 +234,58 @@ def test_a_pair_missed_when_the_criterion_fires():
     assert nb.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
 
 
+def outdated(moved, nlist, box, offset, strain=0.0, group=None, max_checked=16):
+    group = np.empty(0, dtype=np.int64) if group is None else group
+    return nb.list_outdated(moved, nlist.reference, strain, nlist.cutoff, nlist.skin, 0.0, box,
+                            offset, nlist.start, nlist.neighbours, group, max_checked)
+
+
+def test_outliers_checked_pair_by_pair():
+    """A particle moved by more than the skin into open space needs no rebuild; moved next to
+    a particle it is not listed with, it does; the bound alone asks for both."""
+    box = np.array([5.0, 5.0, 5.0])
+    positions = np.array([[1.0, 1.0, 1.0], [1.0, 2.6, 1.0], [3.5, 3.5, 3.5], [3.5, 3.5, 1.5]])
+    nlist, _ = build(positions.copy(), box, 3, 0.0, skin=SKIN)
+    assert nlist.n_pairs == 0
+    away = nlist.reference.copy()
+    away[0] += (-0.45, -0.45, 0.0)  # 0.64 > skin, away from every other particle
+    assert nb.needs_rebuild(away, nlist.reference, 0.0, nlist.cutoff, SKIN)
+    assert not missed_pairs(away, box, 0.0, nlist)
+    assert not outdated(away, nlist, box, 0.0)
+    assert outdated(away, nlist, box, 0.0, max_checked=0)  # too many outliers to check
+    towards = nlist.reference.copy()
+    towards[0, 1] += 0.65  # 0.95 from particle 1, which it is not listed with
+    assert missed_pairs(towards, box, 0.0, nlist)
+    assert outdated(towards, nlist, box, 0.0)
+    # one group: the pair is never listed and never needed
+    assert not outdated(towards, nlist, box, 0.0, group=np.array([0, 0, -1, -1]))
+    towards[2, 0] = np.nan
+    assert outdated(towards, nlist, box, 0.0)
+
+
+@pytest.mark.parametrize("strain", [0.0, 0.05])
+def test_list_outdated_never_misses_a_pair(strain):
+    """Random moves of a few outliers over a bulk that stays within the bound, under shear
+    across the Lees–Edwards faces: the list is kept exactly when brute force finds no pair
+    within h missing from it, in trials where the bound alone would rebuild too."""
+    rng = np.random.default_rng(12)
+    box, positions, offset, nlist = moved_scene(rng)
+    kept_beyond_bound = 0
+    for trial in range(40):
+        moved = nlist.reference.copy()
+        moved[:, 0] += strain * (nlist.reference[:, 1])
+        moved += rng.normal(0.0, 0.02, moved.shape)
+        chosen = rng.choice(len(moved), size=rng.integers(1, 5), replace=False)
+        moved[chosen] += rng.normal(0.0, 0.25, (len(chosen), 3))
+        new_offset = (offset + strain * box[1]) % box[0]
+        keep = not outdated(moved, nlist, box, new_offset, strain)
+        assert keep == (not missed_pairs(moved, box, new_offset, nlist))
+        if keep:
+            kept_beyond_bound += nb.needs_rebuild(moved, nlist.reference, strain,
+                                                  nlist.cutoff, SKIN)
+    assert 5 <= kept_beyond_bound < 35
+
+
 def test_overflow_code_and_error():
     rng = np.random.default_rng(8)
     box, positions = scene("random", (4.0, 4.0, 4.0), 3, rng)

@@ -45,18 +45,27 @@ def test_a_non_newtonian_fluid_updates_s_every_step():
 
 
 def test_holding_s_moves_the_viscosity_far_less_than_the_normalisation_corrects():
-    """Mean σ_xy/(μ γ̇) over 150 steps of a disordered Couette fluid with k = 1, 2 and 4: the
-    held factor changes it by 3.1e-5 at k = 2 and 1.1e-4 at k = 4 (measured; bounds 1e-4 and
-    4e-4), where the normalisation itself corrects about 0.11 (s ≈ 0.84 here)."""
-    def mean_ratio(interval):
+    """Mean σ_xy/(μ γ̇) over 150 steps of a disordered Couette fluid with k = 1, 2 and 4.
+    Holding s for k − 1 steps cannot move it by more than s itself changes in those steps
+    (μ̂ = μ/s): the bound is (k − 1) × the mean per-step |Δs|/s of the k = 1 run (5.8e-3),
+    and 1 % of what the normalisation corrects, 1 − s̄ ≈ 0.18. Measured: 2.8e-4 at k = 2 and
+    3.4e-4 at k = 4. The value depends on when the list is rebuilt, since a rebuild makes s
+    due: with the rebuilds of the two-largest-displacements test alone it read 3.1e-5 and
+    1.1e-4."""
+    def run(interval):
         sim = Simulation(couette_scene(rate=0.2, jitter=0.1, interval=interval), threads=1)
-        stresses = []
-        for _ in range(15):
-            sim.advance(10)
-            stresses.append(sim.sample()["shear_stress"])
-        return np.mean(stresses) / 0.2, np.mean(sim._factor)
+        stresses, changes = [], []
+        for step in range(150):
+            before, rebuilds = sim._factor.copy(), sim.rebuild_count
+            sim.advance(1)
+            if step > 0 and sim.rebuild_count == rebuilds:
+                changes.append(np.mean(np.abs(sim._factor - before) / before))
+            if step % 10 == 9:
+                stresses.append(sim.sample()["shear_stress"])
+        return np.mean(stresses) / 0.2, np.mean(sim._factor), np.mean(changes)
 
-    reference, factor = mean_ratio(1)
-    assert factor < 0.9
-    assert abs(mean_ratio(2)[0] - reference) < 1e-4
-    assert abs(mean_ratio(4)[0] - reference) < 4e-4
+    reference, factor, change = run(1)
+    assert factor < 0.9 and change > 0.0
+    for interval in (2, 4):
+        moved = abs(run(interval)[0] - reference)
+        assert moved < min((interval - 1) * change, 0.01 * (1.0 - factor))
