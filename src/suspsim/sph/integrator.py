@@ -20,13 +20,14 @@ Groot–Warren factor; δt time step [τ]; γ̇ imposed shear rate; Δ Lees–Ed
 """
 from __future__ import annotations
 
+import numpy as np
 from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.boundaries import lees_edwards_offset
 from suspsim.sph.density import (TABLE_OK, body_particle_density, mass_density,
                                  summation_density)
-from suspsim.sph.neighbours import list_outdated
+from suspsim.sph.neighbours import MAX_CHECKED_OUTLIERS, list_outdated
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
 from suspsim.sph.terms.viscous import spin_bulk_coefficient
@@ -171,7 +172,7 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
             drift(positions, velocities, accel, dt)
             if list_outdated(positions, reference, shear_rate * (time - build_time), cutoff,
                              skin, 0.5 * box[1], box, offset, nl_start, nl_neighbours,
-                             body_of):
+                             body_of, np.int64(MAX_CHECKED_OUTLIERS)):
                 return done, REBUILD
         resume = False
         predict(velocities, accel, dt, predicted)

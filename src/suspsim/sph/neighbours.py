@@ -407,9 +407,10 @@ def needs_rebuild(positions, reference, strain, cutoff, skin, y_origin=0.0):
 
 
 #: Most particles moved beyond half the margin that :func:`list_outdated` checks pair by pair
-#: before it asks for a rebuild [choice]. Each costs one distance per particle, about a sixth
-#: of a build's candidates for 16 of them. In the φ = 0.4 benchmark suspension (29,210
-#: particles, 150 steps) rebuilds went from 20 to 13 with 16 to 32 (mean 3 to 6 checked).
+#: before it asks for a rebuild [choice]. Each costs one distance per particle; 16 of them
+#: cost about a sixth of a build's candidate distances. In the φ = 0.4 benchmark suspension
+#: (29,210 particles, 150 steps, two threads) the list was rebuilt 20 times by the bound alone,
+#: 15, 14, 13 and 11 times with at most 8, 16, 32 and 128 checked (3 to 6 checked a step).
 MAX_CHECKED_OUTLIERS = 16
 
 
@@ -476,7 +477,7 @@ def _missed_pairs(i, positions, box, offset, h, start, neighbours, group):
 
 @njit(cache=True)
 def list_outdated(positions, reference, strain, cutoff, skin, y_origin, box, offset, start,
-                  neighbours, group, max_checked=MAX_CHECKED_OUTLIERS):
+                  neighbours, group, max_checked):
     """True when the half list built from ``reference`` may lack a pair now closer than h.
 
     :func:`needs_rebuild`'s bound first: if |d̃|₁st + |d̃|₂nd stays within the margin no pair
@@ -488,7 +489,8 @@ def list_outdated(positions, reference, strain, cutoff, skin, y_origin, box, off
     (squeezed out of the gaps between bodies) set the two largest displacements while the
     99.9th percentile is half as large: the bound alone rebuilt every 7.5 steps where an
     exact test would have waited 21. ``group`` as in :func:`build_neighbour_list` (empty: no
-    groups).
+    groups). Every argument is required, so that numba compiles one signature
+    (:func:`build_neighbour_list`); callers pass :data:`MAX_CHECKED_OUTLIERS`.
     """
     outliers = np.empty(max_checked, dtype=np.int64)
     margin, found, two_largest = _outlier_margin(positions, reference, strain, cutoff, skin,

@@ -46,9 +46,10 @@ from suspsim.sph.health import density_verdict
 from suspsim.sph.integrator import (GROW_TABLE, REBUILD, accelerations, advance_steps, drift,
                                     kick, predict)
 from suspsim.sph.lattice import imposed_velocity, initial_velocities, lattice_positions
-from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbour_list,
-                                    build_neighbour_list, list_outdated, needs_rebuild,
-                                    raise_for_code, rebuild_neighbour_list, sort_by_cell)
+from suspsim.sph.neighbours import (MAX_CHECKED_OUTLIERS, NeighbourListOverflowError,
+                                    allocate_neighbour_list, build_neighbour_list,
+                                    list_outdated, needs_rebuild, raise_for_code,
+                                    rebuild_neighbour_list, sort_by_cell)
 from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
 from suspsim.sph.terms.force_pass import VXY, concentration_column, force_width
 from suspsim.sph.terms.shifting import shift_particles
@@ -485,7 +486,8 @@ class Simulation:
             nl = self._nlist
             if list_outdated(self._x, self._reference, self._rate * (time - self._build_time),
                              nl.cutoff, nl.skin, 0.5 * self._box[1], self._box,
-                             self._offset(time), nl.start, nl.neighbours, self._body_of):
+                             self._offset(time), nl.start, nl.neighbours, self._body_of,
+                             MAX_CHECKED_OUTLIERS):
                 self._rebuild(time)
                 # The rebuild wrapped and reordered x, v and a, not ṽ.
                 predict(self._v, self._a, dt, self._v_pred)

@@ -234,7 +234,8 @@ def test_a_pair_missed_when_the_criterion_fires():
     assert nb.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
 
 
-def outdated(moved, nlist, box, offset, strain=0.0, group=None, max_checked=16):
+def outdated(moved, nlist, box, offset, strain=0.0, group=None,
+             max_checked=nb.MAX_CHECKED_OUTLIERS):
     group = np.empty(0, dtype=np.int64) if group is None else group
     return nb.list_outdated(moved, nlist.reference, strain, nlist.cutoff, nlist.skin, 0.0, box,
                             offset, nlist.start, nlist.neighbours, group, max_checked)
