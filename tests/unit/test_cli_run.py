@@ -209,3 +209,15 @@ def test_bench_unnormalised_scene_runs_only_density_and_force():
     row = benchmark("fluid-newtonian-unnormalised", 3, 1, 8000)
     assert set(row["pass_ms"]) == {"density", "force sums", "force finish"}
     assert row["density_error"] < 0.05
+
+
+def test_bench_suspension_in_a_yield_stress_matrix_times_its_extra_passes():
+    """Spheres in a Papanastasiou matrix add the body density and the smoothed rate to the
+    fluid's passes."""
+    from suspsim.sph.bench import benchmark
+
+    row = benchmark("suspension-papanastasiou", 3, 1, 8000)
+    assert set(row["pass_ms"]) == {"density", "body density", "gradient sums", "gradient finish",
+                                   "rate smoothing", "dissipation sums", "normalisation finish",
+                                   "force sums", "force finish"}
+    assert all(t > 0.0 for t in row["pass_ms"].values())

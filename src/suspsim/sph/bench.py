@@ -41,6 +41,7 @@ from suspsim.scene import scene_from_dict
 from suspsim.sph.density import body_particle_density, mass_density, summation_density
 from suspsim.sph.simulation import SUPPORT, Simulation
 from suspsim.sph.terms.force_pass import force_finish, force_sums
+from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
 from suspsim.sph.terms.velocity_pass import (_dissipation_sums, _gradient_finish, _gradient_sums,
                                              _normalisation_finish)
 from suspsim.sph.terms.viscous import spin_bulk_coefficient
@@ -151,8 +152,9 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
 
     The passes run in step order on the current positions and velocities (the state is
     recomputed, not advanced): density (with the pair table), body density (with bodies),
-    gradient sums and finish, dissipation sums and normalisation finish (when the scene
-    normalises), force sums and finish. Their sum is the step without drift, kick, rebuilds
+    gradient sums and finish, the rate smoothing (non-Newtonian scenes that smooth the rate),
+    dissipation sums and normalisation finish (when the scene normalises), force sums and
+    finish. Their sum is the step without drift, kick, rebuilds
     and the bodies' own work.
     """
     use_threads(sim.threads)
@@ -181,6 +183,12 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
             sim._normalise, sim._beta, sim._spin_correction, sim._body_of, sim._gradient,
             sim._inverse_moment, sim._moment_trace, sim._gdot, sim._mu, sim._strain,
             sim._dissipation)
+    if sim._velocity_gradient and sim._smooth_rate and not sim._newtonian:
+        n = sim.n_particles
+        calls["rate smoothing"] = lambda: smoothed_rate_viscosity(
+            tb.pair_start, tb.pair_end, tb.pair_j, tb.pair_geometry, sim._kernel, SUPPORT,
+            sim._volume, sim._gradient, sim._body_of, law.code, law.packed,
+            sim._grad_acc[:RATE_WIDTH * n], sim._scratch_15, sim._bounds, sim._gdot, sim._mu)
     if sim._normalise:
         if sim._alpha != 0.0:
             calls["dissipation sums"] = lambda: _dissipation_sums(
