@@ -374,47 +374,6 @@ def _build_neighbour_list(positions, box, offset, cutoff, cells, cell_start, sta
 
 
 @njit(cache=True)
-def needs_rebuild(positions, reference, strain, cutoff, skin, y_origin=0.0):
-    """True when a pair beyond r_c at the last build may now be closer than h = r_c − skin.
-
-    Criterion (module docstring): |d̃|₁st + |d̃|₂nd > σ_min(A) r_c − h with
-    d̃ = r − r^b − A (y^b − y_0) ê_x and σ_min = √(1 + A²/4) − |A|/2; ``strain`` A = ∫γ̇ dt
-    since the build (0 without shear); ``y_origin`` y_0 the height at rest in the imposed flow
-    γ̇ (y − y_0) (a uniform translation leaves pair vectors unchanged, so any y_0 is exact;
-    the right one keeps the mean flow from counting as displacement). Positions must not have been wrapped since the build (a wrapped
-    particle shows a box-sized displacement and simply forces a rebuild).
-    """
-    a = abs(strain)
-    margin = (math.sqrt(1.0 + 0.25 * a * a) - 0.5 * a) * cutoff - (cutoff - skin)
-    if margin <= 0.0:
-        return True
-    first2 = 0.0
-    second2 = 0.0
-    for i in range(positions.shape[0]):
-        dx = positions[i, 0] - reference[i, 0] - strain * (reference[i, 1] - y_origin)
-        dy = positions[i, 1] - reference[i, 1]
-        dz = positions[i, 2] - reference[i, 2]
-        d2 = dx * dx + dy * dy + dz * dz
-        if d2 != d2:
-            return True
-        if d2 > second2:
-            if d2 > first2:
-                second2 = first2
-                first2 = d2
-            else:
-                second2 = d2
-    return math.sqrt(first2) + math.sqrt(second2) > margin
-
-
-#: Most particles moved beyond half the margin that :func:`list_outdated` checks pair by pair
-#: before it asks for a rebuild [choice]. Each costs one distance per particle; 16 of them
-#: cost about a sixth of a build's candidate distances. In the φ = 0.4 benchmark suspension
-#: (29,210 particles, 150 steps, two threads) the list was rebuilt 20 times by the bound alone,
-#: 15, 14, 13 and 11 times with at most 8, 16, 32 and 128 checked (3 to 6 checked a step).
-MAX_CHECKED_OUTLIERS = 16
-
-
-@njit(cache=True)
 def _outlier_margin(positions, reference, strain, cutoff, skin, y_origin, outliers):
     """(margin, found, two_largest) of the criterion (module docstring): ``found`` counts the
     particles with |d̃| > margin/2, the first ``outliers.shape[0]`` of them are written into
@@ -443,6 +402,31 @@ def _outlier_margin(positions, reference, strain, cutoff, skin, y_origin, outlie
             else:
                 second2 = d2
     return margin, found, math.sqrt(first2) + math.sqrt(second2)
+
+
+@njit(cache=True)
+def needs_rebuild(positions, reference, strain, cutoff, skin, y_origin=0.0):
+    """True when a pair beyond r_c at the last build may now be closer than h = r_c − skin.
+
+    Criterion (module docstring): |d̃|₁st + |d̃|₂nd > σ_min(A) r_c − h with
+    d̃ = r − r^b − A (y^b − y_0) ê_x and σ_min = √(1 + A²/4) − |A|/2; ``strain`` A = ∫γ̇ dt
+    since the build (0 without shear); ``y_origin`` y_0 the height at rest in the imposed flow
+    γ̇ (y − y_0) (a uniform translation leaves pair vectors unchanged, so any y_0 is exact;
+    the right one keeps the mean flow from counting as displacement). Positions must not have
+    been wrapped since the build (a wrapped particle shows a box-sized displacement and simply
+    forces a rebuild).
+    """
+    margin, _, two_largest = _outlier_margin(positions, reference, strain, cutoff, skin,
+                                             y_origin, np.empty(0, dtype=np.int64))
+    return margin <= 0.0 or two_largest > margin
+
+
+#: Most particles moved beyond half the margin that :func:`list_outdated` checks pair by pair
+#: before it asks for a rebuild [choice]. Each costs one distance per particle; 16 of them
+#: cost about a sixth of a build's candidate distances. In the φ = 0.4 benchmark suspension
+#: (29,210 particles, 150 steps, two threads) the list was rebuilt 20 times by the bound alone,
+#: 15, 14, 13 and 11 times with at most 8, 16, 32 and 128 checked (3 to 6 checked a step).
+MAX_CHECKED_OUTLIERS = 16
 
 
 @njit(cache=True)
