@@ -154,8 +154,7 @@ def pass_times(sim: Simulation, repeats: int = 5) -> dict[str, float]:
     recomputed, not advanced): density (with the pair table), body density (with bodies),
     gradient sums and finish, the rate smoothing (non-Newtonian scenes that smooth the rate),
     dissipation sums and normalisation finish (when the scene normalises), force sums and
-    finish. Their sum is the step without drift, kick, rebuilds
-    and the bodies' own work.
+    finish. Their sum is the step without drift, kick, rebuilds and the bodies' own work.
     """
     use_threads(sim.threads)
     box, tb, nl = sim._box, sim._table, sim._nlist

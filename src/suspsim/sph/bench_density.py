@@ -23,8 +23,9 @@ import numpy as np
 from suspsim.sph import kernels
 from suspsim.sph.boundaries import wrap_particles
 from suspsim.sph.density import allocate_pair_table, summation_density, summation_density_serial
+from suspsim.sph.list_validity import needs_rebuild
 from suspsim.sph.neighbours import (allocate_neighbour_list, apply_permutation,
-                                    build_neighbour_list, needs_rebuild, sort_by_cell)
+                                    build_neighbour_list, sort_by_cell)
 
 
 def benchmark_box(n_side=32, length=20.0, jitter=0.1, seed=1):

@@ -10,7 +10,7 @@ One step of size δt:
 The viscosity update uses ṽ (the gradient pass reads ṽ). The imposed Couette flow is
 γ̇ (y − L_y/2) (``lattice``), at rest at y_0 = L_y/2, the origin of the rebuild criterion. :func:`advance_steps` runs whole steps
 in compiled code and returns early, after the drift of a step, when the neighbour list must be
-rebuilt (``neighbours.list_outdated``) or, after a density pass that found the pair table too
+rebuilt (``list_validity.list_outdated``) or, after a density pass that found the pair table too
 small, the table grown; the caller rebuilds (wrap, sort, list) or grows the table and calls
 again with ``resume=True``, which finishes that step. Time is step_count · δt (no drift of
 round-off).
@@ -27,7 +27,7 @@ from suspsim.sph import JIT_OPTIONS
 from suspsim.sph.boundaries import lees_edwards_offset
 from suspsim.sph.density import (TABLE_OK, body_particle_density, mass_density,
                                  summation_density)
-from suspsim.sph.neighbours import MAX_CHECKED_OUTLIERS, list_outdated
+from suspsim.sph.list_validity import MAX_CHECKED_OUTLIERS, list_outdated
 from suspsim.sph.terms.force_pass import force_finish, force_sums
 from suspsim.sph.terms.rate_smoothing import RATE_WIDTH, smoothed_rate_viscosity
 from suspsim.sph.terms.viscous import spin_bulk_coefficient

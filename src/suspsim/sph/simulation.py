@@ -46,9 +46,9 @@ from suspsim.sph.health import density_verdict
 from suspsim.sph.integrator import (GROW_TABLE, REBUILD, accelerations, advance_steps, drift,
                                     kick, predict)
 from suspsim.sph.lattice import imposed_velocity, initial_velocities, lattice_positions
-from suspsim.sph.neighbours import (MAX_CHECKED_OUTLIERS, NeighbourListOverflowError,
-                                    allocate_neighbour_list, build_neighbour_list,
-                                    list_outdated, needs_rebuild, raise_for_code,
+from suspsim.sph.list_validity import MAX_CHECKED_OUTLIERS, list_outdated, needs_rebuild
+from suspsim.sph.neighbours import (NeighbourListOverflowError, allocate_neighbour_list,
+                                    build_neighbour_list, raise_for_code,
                                     rebuild_neighbour_list, sort_by_cell)
 from suspsim.sph.stress import mean_pressure, pressure_tensor, shear_stress
 from suspsim.sph.terms.force_pass import VXY, concentration_column, force_width

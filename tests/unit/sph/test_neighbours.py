@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from suspsim.sph import kernels as K
+from suspsim.sph import list_validity as lv
 from suspsim.sph import neighbours as nb
 from suspsim.sph.density import (DX, DZ, F, GEOMETRY_DTYPE, TABLE_OK, TABLE_OVERFLOW,
                                  allocate_pair_table, summation_density,
@@ -182,7 +183,7 @@ def test_no_pair_missed_below_half_skin():
     step = rng.normal(size=positions.shape)
     step *= (0.499 * SKIN) * rng.uniform(0.5, 1, (len(step), 1)) / np.linalg.norm(step, axis=1)[:, None]
     moved = positions + step  # unwrapped: positions may leave the box
-    assert not nb.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
+    assert not lv.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
     assert not missed_pairs(moved, box, offset, nlist)
 
 
@@ -196,7 +197,7 @@ def test_no_pair_missed_under_affine_shear():
     moved[:, 0] += strain * positions[:, 1]
     moved += rng.uniform(-0.01, 0.01, moved.shape)
     new_offset = (offset + strain * box[1]) % box[0]
-    assert not nb.needs_rebuild(moved, nlist.reference, strain, nlist.cutoff, SKIN)
+    assert not lv.needs_rebuild(moved, nlist.reference, strain, nlist.cutoff, SKIN)
     assert not missed_pairs(moved, box, new_offset, nlist)
 
 
@@ -206,21 +207,21 @@ def test_rebuild_triggered():
     reference = nlist.reference
     moved = positions.copy()
     moved[3, 0] += 0.16
-    assert not nb.needs_rebuild(moved, reference, 0.0, nlist.cutoff, SKIN)
+    assert not lv.needs_rebuild(moved, reference, 0.0, nlist.cutoff, SKIN)
     moved[8, 1] -= 0.16  # two particles approaching by 0.32 > skin
-    assert nb.needs_rebuild(moved, reference, 0.0, nlist.cutoff, SKIN)
+    assert lv.needs_rebuild(moved, reference, 0.0, nlist.cutoff, SKIN)
     # at rest while the offset slides: the images of particles near the faces approach
-    assert not nb.needs_rebuild(positions, reference, 0.001, nlist.cutoff, SKIN)
-    assert nb.needs_rebuild(positions, reference, 0.1, nlist.cutoff, SKIN)
+    assert not lv.needs_rebuild(positions, reference, 0.001, nlist.cutoff, SKIN)
+    assert lv.needs_rebuild(positions, reference, 0.1, nlist.cutoff, SKIN)
     # affine motion: the strain alone triggers once the sheared cutoff sphere dips below h
     sheared = positions.copy()
     sheared[:, 0] += 0.6 * positions[:, 1]
-    assert nb.needs_rebuild(sheared, reference, 0.6, nlist.cutoff, SKIN)
+    assert lv.needs_rebuild(sheared, reference, 0.6, nlist.cutoff, SKIN)
     wrapped = positions.copy()
     wrapped[0, 1] -= box[1]  # a wrap between builds shows as a jump and forces a rebuild
-    assert nb.needs_rebuild(wrapped, reference, 0.0, nlist.cutoff, SKIN)
+    assert lv.needs_rebuild(wrapped, reference, 0.0, nlist.cutoff, SKIN)
     wrapped[0, 1] = np.nan
-    assert nb.needs_rebuild(wrapped, reference, 0.0, nlist.cutoff, SKIN)
+    assert lv.needs_rebuild(wrapped, reference, 0.0, nlist.cutoff, SKIN)
 
 
 def test_a_pair_missed_when_the_criterion_fires():
@@ -231,13 +232,13 @@ def test_a_pair_missed_when_the_criterion_fires():
     moved = nlist.reference.copy()
     moved[:, 0] += np.where(moved[:, 0] < 2, 0.2, -0.2)
     assert missed_pairs(moved, box, 0.0, nlist)
-    assert nb.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
+    assert lv.needs_rebuild(moved, nlist.reference, 0.0, nlist.cutoff, SKIN)
 
 
 def outdated(moved, nlist, box, offset, strain=0.0, group=None,
-             max_checked=nb.MAX_CHECKED_OUTLIERS):
+             max_checked=lv.MAX_CHECKED_OUTLIERS):
     group = np.empty(0, dtype=np.int64) if group is None else group
-    return nb.list_outdated(moved, nlist.reference, strain, nlist.cutoff, nlist.skin, 0.0, box,
+    return lv.list_outdated(moved, nlist.reference, strain, nlist.cutoff, nlist.skin, 0.0, box,
                             offset, nlist.start, nlist.neighbours, group, max_checked)
 
 
@@ -250,7 +251,7 @@ def test_outliers_checked_pair_by_pair():
     assert nlist.n_pairs == 0
     away = nlist.reference.copy()
     away[0] += (-0.45, -0.45, 0.0)  # 0.64 > skin, away from every other particle
-    assert nb.needs_rebuild(away, nlist.reference, 0.0, nlist.cutoff, SKIN)
+    assert lv.needs_rebuild(away, nlist.reference, 0.0, nlist.cutoff, SKIN)
     assert not missed_pairs(away, box, 0.0, nlist)
     assert not outdated(away, nlist, box, 0.0)
     assert outdated(away, nlist, box, 0.0, max_checked=0)  # too many outliers to check
@@ -282,7 +283,7 @@ def test_list_outdated_never_misses_a_pair(strain):
         keep = not outdated(moved, nlist, box, new_offset, strain)
         assert keep == (not missed_pairs(moved, box, new_offset, nlist))
         if keep:
-            kept_beyond_bound += nb.needs_rebuild(moved, nlist.reference, strain,
+            kept_beyond_bound += lv.needs_rebuild(moved, nlist.reference, strain,
                                                   nlist.cutoff, SKIN)
     assert 5 <= kept_beyond_bound < 35
 
