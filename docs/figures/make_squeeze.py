@@ -1,7 +1,7 @@
 """Make docs/figures/squeeze_force.{nc,png}: resolved SPH squeeze force between two spheres.
 
     python docs/figures/make_squeeze.py [--threads N] [--reduced] [--no-large]
-        [--set numerics.KEY=VALUE ...]
+        [--set numerics.KEY=VALUE ...] [--slide K]
     python docs/figures/make_squeeze.py --plot-only    # redraw from the .nc
 
 Runs :func:`suspsim.validation.squeeze.squeeze_study` for a = 2.5 h (box 25 × 20 × 20 h,
@@ -13,7 +13,10 @@ the scene applies (auto: ``scene_rules.AUTO_CUTOFF_GAP_CORRECTED``). --reduced: 
 case only, printed and not written. The runs are kept in ``squeeze_force.nc`` (netCDF4
 groups, one per run, named by its label). ``--set`` takes
 numerics keys of the runs' scenes (VALUE as JSON, e.g. ``numerics.shifting=100``); such runs
-print their tables and write no file.
+print their tables and write no file. ``--slide K``: the spheres also slide past each other at
+±K U while they approach (``squeeze_run``'s ``slide_ratio``; K = 1 is a pair at 45° in the
+compressional quadrant of a shear), at Re = 0.05 only; the table adds the sliding force over
+Jeffrey–Onishi's Y^A, and nothing is written.
 """
 import argparse
 import json
@@ -36,11 +39,15 @@ def _table(data, title):
           f", {a['n_particles']} particles, wall {a['squeeze_wall_time_s']:.0f} s + "
           f"{a['drag_wall_time_s']:.0f} s; cutoff gap s_c = {a['cutoff_gap']:.3g} h")
     print(f"lubrication correction at the scene's cutoff {a['lubrication_cutoff_gap']:.3g} h")
-    print("   s [h]   F/(6pi mu a U)   F/F_th(a_h)   F/F_th(a)   +lub./F_th(a)   box/free")
-    for s, n, r, rn, rc, c in zip(data["gap"].values, data["normalised_force"].values,
-                                  data["ratio"].values, data["ratio_nominal"].values,
-                                  data["ratio_combined"].values, data["image_correction"].values):
-        print(f"  {s:6.3f}   {n:12.4g}   {r:11.3f}   {rn:9.3f}   {rc:13.3f}   {c:8.3f}")
+    sliding = data["ratio_sliding"].values if "ratio_sliding" in data else None
+    print("   s [h]   F/(6pi mu a U)   F/F_th(a_h)   F/F_th(a)   +lub./F_th(a)   box/free"
+          + ("   sliding/F_th(a)" if sliding is not None else ""))
+    for k, (s, n, r, rn, rc, c) in enumerate(zip(
+            data["gap"].values, data["normalised_force"].values, data["ratio"].values,
+            data["ratio_nominal"].values, data["ratio_combined"].values,
+            data["image_correction"].values)):
+        print(f"  {s:6.3f}   {n:12.4g}   {r:11.3f}   {rn:9.3f}   {rc:13.3f}   {c:8.3f}"
+              + (f"   {sliding[k]:15.3f}" if sliding is not None else ""))
 
 
 def _save(runs, labels) -> None:
@@ -65,6 +72,8 @@ def main() -> None:
     parser.add_argument("--plot-only", action="store_true", help=f"redraw from {NETCDF.name}")
     parser.add_argument("--set", action="append", default=[], metavar="numerics.KEY=VALUE",
                         help="a numerics key of every run (repeatable; nothing is written)")
+    parser.add_argument("--slide", type=float, default=0.0, metavar="K",
+                        help="slide at +-K U while approaching (nothing is written)")
     args = parser.parse_args()
     numerics = {}
     for item in args.set:
@@ -73,6 +82,7 @@ def main() -> None:
             parser.error(f"--set {item}: give numerics.KEY=VALUE")
         numerics[key.removeprefix("numerics.")] = json.loads(value)
     common = {"threads": args.threads, "numerics": numerics or None}
+    slide = {"slide_ratio": args.slide} if args.slide > 0 else {}
     runs, labels = [], []
     if args.plot_only:
         with xr.open_datatree(NETCDF) as tree:
@@ -81,20 +91,22 @@ def main() -> None:
                 labels.append(node.attrs["label"])
     elif args.reduced:
         runs.append(squeeze_study(2.5, (20.0, 15.0, 15.0), reynolds=0.1, end_gap=0.1,
-                                  **common))
+                                  **common, **slide))
         labels.append("a = 2.5 h, reduced")
     else:
         box = (25.0, 20.0, 20.0)
         drag = stokes_drag(2.5, box, reynolds=0.05, **common)
-        for reynolds in (0.05, 0.025):
-            runs.append(squeeze_study(2.5, box, reynolds=reynolds, drag=drag, **common))
+        for reynolds in (0.05,) if args.slide > 0 else (0.05, 0.025):
+            runs.append(squeeze_study(2.5, box, reynolds=reynolds, drag=drag, **common,
+                                      **slide))
             labels.append(f"a = 2.5 h, Re = {reynolds:g}")
         if not args.no_large:
-            runs.append(squeeze_study(4.0, (32.0, 25.0, 25.0), reynolds=0.1, **common))
+            runs.append(squeeze_study(4.0, (32.0, 25.0, 25.0), reynolds=0.1, **common,
+                                      **slide))
             labels.append("a = 4 h, Re = 0.1")
     for data, label in zip(runs, labels):
         _table(data, label)
-    if numerics or args.reduced:
+    if numerics or args.reduced or args.slide > 0:
         return
     if not args.plot_only:
         _save(runs, labels)

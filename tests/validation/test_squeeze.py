@@ -1,7 +1,7 @@
 """Resolved SPH squeeze force between two spheres against Jeffrey & Onishi (SPEC §3.3).
 
-Fast tests check the theory (JO X^A functions against their published limits, the Ewald image
-sum against Hasimoto's constant); the slow test runs the prescribed approach at reduced size
+Fast tests check the theory (JO X^A and Y^A functions against their published limits, the Ewald
+image sum against Hasimoto's constant); the slow test runs the prescribed approach at reduced size
 (``SUSPSIM_REDUCED=1``: box 20 × 15 × 15 h, Re = 0.1, about three minutes on one core) or at the
 size of ``docs/figures/make_squeeze.py`` and compares the binned force with theory.
 """
@@ -10,10 +10,13 @@ import math
 import numpy as np
 import pytest
 
-from suspsim.validation.squeeze import (cutoff_gap, hasimoto_factor, lubrication_correction,
+from suspsim.validation.jeffrey_onishi import (squeeze_resistance, xa_coefficients, xa_functions,
+                                               ya_coefficients, ya_functions)
+from suspsim.validation.squeeze import (bin_series, cutoff_gap, gap_edges, hasimoto_factor,
+                                        image_mobility, lubrication_correction, periodic_oseen,
                                         periodic_oseen_xx, periodic_self_coefficient, reduced,
-                                        squeeze_resistance, squeeze_study, squeeze_theory,
-                                        xa_coefficients, xa_functions)
+                                        sliding_theory, squeeze_run, squeeze_study,
+                                        squeeze_theory)
 
 
 def test_jeffrey_onishi_coefficients_match_the_tabulated_ones():
@@ -44,6 +47,62 @@ def test_xa_far_field_matches_the_reflection_series():
     # Squeeze: leading lubrication (3/2)πμa²(2U)/s = 6πμaU · a/(2s).
     s = 1e-3
     assert squeeze_resistance(s, 1.0) == pytest.approx(1 / (2 * s), rel=0.01)
+
+
+def test_jeffrey_onishi_sliding_coefficients_match_the_tabulated_ones():
+    # f_k(λ) of JO Eq. 4.12: 1, 3λ/2, 9λ/4, 2λ + 27λ²/8 + 2λ³, 6λ + 81λ²/16 + 18λ³
+    np.testing.assert_allclose(ya_coefficients(1.0, 4), [1, 1.5, 2.25, 7.375, 29.0625],
+                               rtol=1e-12)
+    lam = 0.5
+    f = ya_coefficients(lam, 4)
+    assert f[3] == pytest.approx(2 * lam + 27 / 8 * lam ** 2 + 2 * lam ** 3, rel=1e-12)
+    assert f[4] == pytest.approx(6 * lam + 81 / 16 * lam ** 2 + 18 * lam ** 3, rel=1e-12)
+
+
+def test_ya_near_contact_and_far_field_match_the_published_limits():
+    # Equal spheres near contact: Y11A = (1/6) ln(1/ξ) + 0.9983, Y12A = −(1/6) ln(1/ξ) − 0.2737
+    # (JO 1984 Eqs. 4.15–4.16 with A^Y_11(1), A^Y_12(1); g₃ = 0 at λ = 1).
+    for xi in (1e-3, 3e-3):
+        y11, y12 = ya_functions(np.array([2.0 + xi]))
+        assert y11[0] == pytest.approx(math.log(1 / xi) / 6 + 0.9983, abs=2e-3)
+        assert y12[0] == pytest.approx(-math.log(1 / xi) / 6 - 0.2737, abs=2e-3)
+    # Far field, t = r/a: Y11A = Σ f_2k/(2t)^2k, Y12A = −Σ f_2k+1/(2t)^2k+1 (JO 4.13–4.14).
+    t = 20.0
+    f = ya_coefficients(1.0, 5)
+    y11, y12 = ya_functions(np.array([t]))
+    assert y11[0] == pytest.approx(1 + f[2] / (2 * t) ** 2 + f[4] / (2 * t) ** 4, rel=1e-6)
+    assert y12[0] == pytest.approx(-(f[1] / (2 * t) + f[3] / (2 * t) ** 3 + f[5] / (2 * t) ** 5),
+                                  rel=1e-6)
+
+
+def test_ewald_tensor_is_symmetric_and_independent_of_splitting():
+    box = [20.0, 15.0, 15.0]
+    a = periodic_oseen([3.0, 1.0, 0.5], box, splitting=0.15)
+    b = periodic_oseen([3.0, 1.0, 0.5], box, splitting=0.3)
+    np.testing.assert_allclose(a, b, rtol=1e-7, atol=1e-12)
+    np.testing.assert_allclose(a, a.T, atol=1e-15)
+    # A cube is isotropic at the origin: the self term is c₁/(6π) times I.
+    cube = periodic_oseen(np.zeros(3), [20.0] * 3)
+    np.testing.assert_allclose(cube, cube[0, 0] * np.eye(3), atol=1e-12)
+
+
+def test_image_term_turns_with_the_pair():
+    box = [20.0, 20.0, 20.0]
+    gap = np.array([0.3, 1.5])
+    # In a cube a pair along x and one along y see the same images.
+    np.testing.assert_allclose(image_mobility(gap, 2.5, box, angle=math.pi / 2),
+                               image_mobility(gap, 2.5, box), rtol=1e-9)
+    np.testing.assert_allclose(image_mobility(gap, 2.5, box, angle=math.pi / 2, mode="sliding"),
+                               image_mobility(gap, 2.5, box, mode="sliding"), rtol=1e-9)
+    # Along x, the squeeze term is the xx projection of the image tensor, suppressed by 1 − A.
+    r = 2 * 2.5 + gap[1]
+    unsuppressed = 6 * math.pi * 2.5 * (periodic_oseen_xx(np.zeros(3), box)
+                                        - periodic_oseen_xx([r, 0.0, 0.0], box))
+    suppressed = image_mobility(gap[1:], 2.5, box)[0]
+    assert 0.0 < suppressed / unsuppressed < 1.0
+    sliding_images = sliding_theory(gap, 2.5, 1.0, 1e-3, box=[400.0] * 3)
+    np.testing.assert_allclose(sliding_images / sliding_theory(gap, 2.5, 1.0, 1e-3), 1.0,
+                               atol=2e-3)
 
 
 def test_ewald_self_term_gives_hasimoto_constant_independent_of_splitting():
@@ -94,9 +153,11 @@ def test_resolved_squeeze_force_follows_theory_down_to_the_cutoff():
     """With the defaults of a scene with bodies (spin correction, A = 30 at the rate U/a).
     Measured (make_squeeze.py, 2026-12-06): a = 2.5 h, Re = 0.05: a_h/a = 1.056 from the drag;
     at 1–2.5 h F_SPH/F_theory 0.96–1.07 with a_h and 1.21–1.28 with the nominal a; below 0.9 ×
-    F_theory(a) from 0.25 h (0.185 h at Re = 0.025, 0.18 h at a = 4 h; the scene's auto cutoff
-    0.185 h); with the scene's lubrication correction the total reads 0.76–1.28 × F_theory(a)
-    from 0.06 h to 2.5 h. Reduced size (box 20 × 15 × 15 h, Re = 0.1): a_h/a = 1.067; at
+    F_theory(a) from 0.25 h (0.185 h at Re = 0.025, 0.18 h at a = 4 h); with the lubrication
+    correction of the cutoff 0.185 h the total read 0.76–1.28 × F_theory(a) from 0.06 h to
+    2.5 h. The scene's auto cutoff is now 0.328 h, where the squeeze falls short once the
+    spheres also slide (the next test), so here a pure approach must fall short inside three
+    quarters of it. Reduced size (box 20 × 15 × 15 h, Re = 0.1): a_h/a = 1.067; at
     1–2.5 h 0.81–0.90 with a_h and 1.02–1.12 with a; below 0.9 from 0.47 h; the total
     0.66–1.12. So the resolved force lies between the theories of the two radii, and the
     check takes that band with a 15 % margin; the total's band [0.6, 1.4] is a guard (the
@@ -120,10 +181,47 @@ def test_resolved_squeeze_force_follows_theory_down_to_the_cutoff():
     np.testing.assert_array_less(hydrodynamic, 1.15)
     # The resolved force must fall short of the lubrication singularity inside the cutoff.
     scene_cutoff = data.attrs["lubrication_cutoff_gap"]
-    near = data["ratio_nominal"].where(gap < scene_cutoff, drop=True).values
+    near = data["ratio_nominal"].where(gap < 0.75 * scene_cutoff, drop=True).values
     assert near.size >= 1 and near.max() < 0.9
     if not reduced():
         assert scene_cutoff / 1.5 < data.attrs["cutoff_gap"] < 1.5 * scene_cutoff
     total = data["ratio_combined"].where(gap <= 2.5, drop=True).values
     np.testing.assert_array_less(0.6, total)
     np.testing.assert_array_less(total, 1.4)
+
+
+@pytest.mark.slow
+def test_resolved_sliding_force_never_falls_short_of_theory():
+    """Approach while sliding at equal speeds (``slide_ratio`` 1: a pair at 45° in a shear's
+    compressional quadrant), the defaults of a scene with bodies. Measured (2026-12-07; full
+    size ``make_squeeze.py --no-large --slide 1``, box 25 × 20 × 20 h, Re = 0.05): the force
+    resisting the sliding reads 1.13–1.48 × Jeffrey–Onishi's Y^A at 0.06–0.8 h and 1.23–1.28 at
+    1–2.5 h (A = 3: 0.98–1.23; A = 100: 1.08–1.61), so the SPH fluid resolves the tangential
+    mode down to contact and it never sets the cutoff; the squeeze force beside it falls below
+    0.9 × F_theory(a) from 0.33 h at A = 30 and 100 (pure approach: 0.25 and 0.14 h) and from
+    0.58 h at A = 3 (as without sliding). Reduced size (box 20 × 15 × 15 h, Re = 0.1): sliding
+    0.99–1.27 × theory at 0.12–4.4 h, squeeze below 0.9 from 0.27 h. The bounds: sliding at
+    least 0.9 × theory at every gap from 0.1 h (the brief's 10 %) and at most 1.5 × at 1–2.5 h;
+    the squeeze below 0.9 inside the scene's cutoff."""
+    if reduced():
+        box, reynolds, end_gap = (20.0, 15.0, 15.0), 0.1, 0.1
+    else:
+        box, reynolds, end_gap = (25.0, 20.0, 20.0), 0.05, 0.05
+    run = squeeze_run(2.5, box, reynolds=reynolds, end_gap=end_gap, slide_ratio=1.0)
+    assert run["healthy"], run["health"]
+    edges = gap_edges(2.5, end_gap, 8)
+    gap, sliding, _ = bin_series(run["gap"], run["sliding_force"], edges)
+    squeeze = bin_series(run["gap"], run["force"], edges)[1]
+    angle = bin_series(run["gap"], run["angle"], edges)[1]
+    keep = np.isfinite(sliding)
+    gap, sliding, squeeze, angle = gap[keep], sliding[keep], squeeze[keep], angle[keep]
+    # The line of centres turns by about 0.9 rad as the spheres pass.
+    assert 0.5 < angle[0] < 1.2
+    ratio = sliding / sliding_theory(gap, 2.5, 1.0, run["speed"], box, angle=angle)
+    np.testing.assert_array_less(0.9, ratio[gap >= 0.1])
+    middle = (gap >= 1.0) & (gap <= 2.5)
+    assert middle.sum() >= 3
+    np.testing.assert_array_less(ratio[middle], 1.5)
+    squeeze_ratio = squeeze / squeeze_theory(gap, 2.5, 1.0, run["speed"], box, angle=angle)
+    near = squeeze_ratio[gap < run["lubrication_cutoff_gap"]]
+    assert near.size >= 1 and near.max() < 0.9

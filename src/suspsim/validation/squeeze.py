@@ -11,8 +11,9 @@ The motion is **prescribed**: before every step the bodies' velocities are reset
 :meth:`~suspsim.bodies.system.RigidBodies.set_motion` to ±U x̂ (relative speed 2U, no rotation),
 so the integrator's kick never changes them; the force recorded after the step is the fluid
 force of that step's force pass. The spheres start at gap ``start_gap`` (a spin-up stretch that
-is not reported) and are stopped at ``end_gap``. Squeeze force F = (F_2,x − F_1,x)/2 > 0 (the
-fluid resists the approach). Samples are averaged in logarithmic gap bins.
+is not reported) and are stopped at ``end_gap``. Squeeze force F = (F_2 − F_1)·d/2 > 0 along
+the line of centres d (the fluid resists the approach). Samples are averaged in logarithmic gap
+bins.
 
 Hydrodynamic radius (:func:`stokes_drag`): one sphere at prescribed speed U relative to the
 mean fluid velocity in the same box. SPH conserves momentum, so the fluid's mean velocity grows
@@ -25,20 +26,21 @@ with c₁ the point-force periodic self-correction of the box (:func:`periodic_s
 c₁ L = −2.837297 for a cube: Hasimoto 1959) and (4π/3)a³/V ≈ 4.19 (a/L)³ for a cube.
 
 Theory (:func:`squeeze_theory`): the resistance of two equal spheres moving along their line
-of centres with velocities ±U, F = 6πμ a U (X11A − X12A), from Jeffrey & Onishi (1984, J. Fluid
-Mech. 139, 261): the twin-multipole coefficients f_k (their Eqs. 3.6–3.9, 3.15, the recurrence
-as printed in Townsend, arXiv:1802.08226, and checked against the tabulated f_0…f_6 of
-K. Ichiki's libstokes ``src/XA.c``: f_2 = 9λ, f_3 = −4λ + 27λ² − 4λ³, …) summed in JO's
-uniformly valid "near-field" form (JO Eqs. 3.20–3.21, Townsend's corrected version) that
-subtracts the singular g₁/ξ + g₂ ln(1/ξ) + g₃ ξ ln(1/ξ) behaviour (SPEC §3.3 table: 1/4, 9/40,
-3/112 at λ = 1) and adds it back in closed form, so the sum is accurate from contact to
-infinity. The box images are added at the mobility level: the squeeze-mode mobility
-m = 1/(X11A − X12A) gains Δ = 6πμ a [(G_per − G)(0) − (G_per − G)(r)]_xx (Hasimoto–Ewald
-periodic Oseen tensor, :func:`periodic_oseen_xx`), the image strain across the pair; near
+of centres with velocities ±U, F = 6πμ a U (X11A − X12A), Jeffrey & Onishi's (1984) exact
+functions (:mod:`~suspsim.validation.jeffrey_onishi`). The box images are added at the
+mobility level: the squeeze-mode mobility m = 1/(X11A − X12A) gains Δ = 6πμ a [(G_per − G)(0)
+− (G_per − G)(r)]_xx (Hasimoto–Ewald periodic Oseen tensor, :func:`periodic_oseen`), the image
+strain across the pair; near
 contact this relative motion is suppressed by lubrication, by 1 − A(r) (Batchelor & Green 1972,
 A = 5/ρ³ − 8/ρ⁵ + 25/ρ⁶ − 35/ρ⁸ + 125/ρ⁹ − 102/ρ¹⁰ + 12.5/ρ¹¹ + 430/ρ¹², ρ = r/a, capped at
 1 − 4.077 ξ near contact) [choice: an approximation; the size of the correction is reported,
 ``image_correction``, and is a few per cent at most in the default boxes].
+
+Approach while sliding (``slide_ratio`` k > 0): the spheres also move at ∓kU normal to the
+line of centres in the xy plane, so the line turns as they pass and the pair's relative motion
+is that of a shear flow's compressional quadrant (k = 1: at 45°). The force resisting the
+sliding is compared with 6πμaU k (Y11A − Y12A) (:func:`sliding_theory`, spheres held from
+turning), and the squeeze force with the theory for the line's present angle.
 
 Comparison: theory evaluated with the hydrodynamic radius a_h (gap s_h = r − 2a_h) and with
 the nominal a; the reported gap is the nominal s = r − 2a. The recommended cutoff s_c is the
@@ -57,7 +59,6 @@ L box side; V box volume; Re = ρ_f U a/μ particle Reynolds number.
 """
 from __future__ import annotations
 
-import functools
 import math
 import os
 import tempfile
@@ -66,7 +67,6 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from numba import njit
 from scipy.optimize import brentq
 from scipy.special import erfc
 
@@ -74,6 +74,8 @@ from suspsim.bodies.lubrication import pair_mode_resistances
 from suspsim.io.provenance import provenance
 from suspsim.io.variables import UNIT_SYSTEM
 from suspsim.scene_rules import AUTO_SHIFTING_WITH_INCLUSIONS
+
+from .jeffrey_onishi import sliding_resistance, squeeze_resistance
 
 REFERENCES = (
     "Jeffrey & Onishi, J. Fluid Mech. 139, 261 (1984) (X^A resistance functions); "
@@ -84,8 +86,6 @@ REFERENCES = (
 
 #: Hasimoto's cubic-array constants (SPEC §3.1).
 HASIMOTO = (2.837297, 4.19, 27.4)
-#: Terms of the twin-multipole sums [choice: converged to < 1e-6 for ξ ≥ 0.01].
-SERIES_TERMS = 160
 #: F_SPH/F_theory below this counts as failing theory (the brief: 10 %).
 CUTOFF_RATIO = 0.9
 #: Default sound speed [h τ⁻¹] and particle Reynolds number of the runs [choice].
@@ -98,111 +98,23 @@ REYNOLDS = 0.05
 SHIFTING_COEFFICIENT = AUTO_SHIFTING_WITH_INCLUSIONS
 
 
-# ---------------------------------------------------------------- Jeffrey & Onishi X^A
-@njit(cache=True)
-def _p_table(m):
-    """P_{n,p,q} and V_{n,p,q} of JO (1984) Eqs. 3.6–3.9 for n ≤ m, p + q ≤ m."""
-    size = m + 2
-    p_ = np.zeros((size, size, size))
-    v_ = np.zeros((size, size, size))
-    p_[1, 0, 0] = 1.0
-    v_[1, 0, 0] = 1.0
-    for total in range(1, m + 1):
-        for q in range(total + 1):
-            p = total - q
-            for n in range(1, m + 1):
-                acc = 0.0
-                acc_v = 0.0
-                c1 = n * (2.0 * n + 1.0) / (2.0 * (n + 1.0))
-                c2 = -n * (2.0 * n - 1.0) / (2.0 * (n + 1.0))
-                c3 = -n * (4.0 * n * n - 1.0) / (2.0 * (n + 1.0))
-                binomial = 1.0
-                for s in range(1, q + 1):
-                    binomial *= (n + s) / s          # C(n+s, n)
-                    up, down = p - n + 1, p - n - 1
-                    if up >= 0:
-                        acc += binomial * c1 * (2.0 * n * s - n - s + 2.0) / (
-                            (2.0 * s - 1.0) * (n + s)) * p_[s, q - s, up]
-                        if q - s - 2 >= 0:
-                            acc += binomial * c3 / (2.0 * s + 1.0) * v_[s, q - s - 2, up]
-                    if down >= 0:
-                        acc += binomial * c2 * p_[s, q - s, down]
-                        acc_v += binomial * p_[s, q - s, down]
-                p_[n, p, q] = acc
-                v_[n, p, q] = acc - 2.0 * n / ((n + 1.0) * (2.0 * n + 3.0)) * acc_v
-    return p_
-
-
-@functools.lru_cache(maxsize=4)
-def xa_coefficients(size_ratio: float = 1.0, terms: int = SERIES_TERMS) -> np.ndarray:
-    """f_k(λ), k = 0 … terms, of JO Eq. 3.15: f_k = 2^k Σ_q P_{1,k−q,q} λ^q."""
-    table = _p_table(terms)
-    out = np.zeros(terms + 1)
-    for k in range(terms + 1):
-        out[k] = 2.0 ** k * sum(table[1, k - q, q] * size_ratio ** q for q in range(k + 1))
-    return out
-
-
-def _g(size_ratio):
-    lam = size_ratio
-    return (2.0 * lam ** 2 / (1 + lam) ** 3,
-            lam * (1 + 7 * lam + lam ** 2) / (5.0 * (1 + lam) ** 3),
-            (1 + 18 * lam - 29 * lam ** 2 + 18 * lam ** 3 + lam ** 4) / (42.0 * (1 + lam) ** 3))
-
-
-def xa_functions(distance, size_ratio: float = 1.0, terms: int = SERIES_TERMS):
-    """(X11A, X12A) at dimensionless centre distance t = 2r/(a₁ + a₂) > 2 (JO's s).
-
-    Uniformly valid form (module docstring): singular parts in closed form plus the
-    rapidly convergent remainder series; normalisation of Kim & Karrila (F₁ = −6πμa₁ X11A U₁
-    − 6πμa₁ X12A U₂ for λ = 1 along the line of centres).
-    """
-    t = np.asarray(distance, dtype=float)
-    if np.any(t <= 2.0):
-        raise ValueError("xa_functions: the spheres overlap (t = 2r/(a1+a2) must exceed 2)")
-    f = xa_coefficients(float(size_ratio), terms)
-    g1, g2, g3 = _g(size_ratio)
-    u = 2.0 / t
-    arg = 1.0 - u * u
-    x11 = np.zeros_like(t)
-    x12 = np.zeros_like(t)
-    for m in range(1, terms + 1):
-        m1 = -2.0 if m == 2 else m - 2.0
-        coefficient = 2.0 ** -m * (1.0 + size_ratio) ** -m * f[m] - g1 - 2.0 / m * g2
-        coefficient += 4.0 / (m * m1) * g3
-        if m % 2 == 0:
-            x11 += coefficient * u ** m
-        else:
-            x12 += coefficient * u ** m
-    x11 += g1 / arg - g2 * np.log(arg) - g3 * arg * np.log(arg) + f[0] - g1
-    log_term = np.log((t + 2.0) / (t - 2.0))
-    x12 += u * g1 / arg + g2 * log_term + g3 * arg * log_term + 4.0 * g3 / t
-    return x11, -x12
-
-
-def squeeze_resistance(gap, radius: float):
-    """X11A − X12A for equal spheres of ``radius`` at surface gap ``gap`` [h]: the free-space
-    squeeze force is 6πμ a U (X11A − X12A) for velocities ±U."""
-    x11, x12 = xa_functions(2.0 + np.asarray(gap, dtype=float) / radius)
-    return x11 - x12
-
-
 # ---------------------------------------------------------------- periodic images
 def _ewald_split(box):
     return math.sqrt(math.pi) / float(np.prod(box)) ** (1.0 / 3.0)
 
 
-def periodic_oseen_xx(displacement, box, *, splitting: float | None = None,
-                      images: int = 4, waves: int = 8) -> float:
-    """xx component of (G_per − G)(r) · μ for a point force in a periodic box [h⁻¹], where G is
-    the free Oseen tensor and G_per its Hasimoto (1959) periodic sum without the k = 0 mode,
-    by Ewald summation (real part (1/8πμ)[I(erfc(ξr)/r − 2ξe^{−ξ²r²}/√π) + r̂r̂(erfc(ξr)/r
+def periodic_oseen(displacement, box, *, splitting: float | None = None,
+                   images: int = 4, waves: int = 8) -> np.ndarray:
+    """(G_per − G)(r) · μ (3, 3) for a point force in a periodic box [h⁻¹], where G is the free
+    Oseen tensor and G_per its Hasimoto (1959) periodic sum without the k = 0 mode, by Ewald
+    summation (real part (1/8πμ)[I(erfc(ξr)/r − 2ξe^{−ξ²r²}/√π) + r̂r̂(erfc(ξr)/r
     + 2ξe^{−ξ²r²}/√π)], Fourier part (1/μV) Σ (I − k̂k̂)(1 + k²/4ξ²) e^{−k²/4ξ²}/k² cos k·r).
     ``displacement`` r (3,) [h]; r = 0 gives the self term."""
     box = np.asarray(box, dtype=float)
     r0 = np.asarray(displacement, dtype=float)
     xi = _ewald_split(box) if splitting is None else splitting
-    total = 0.0
+    root_pi = math.sqrt(math.pi)
+    total = np.zeros((3, 3))
     rng = range(-images, images + 1)
     for i in rng:
         for j in rng:
@@ -210,25 +122,33 @@ def periodic_oseen_xx(displacement, box, *, splitting: float | None = None,
                 vec = r0 + box * np.array([i, j, k])
                 r = float(np.sqrt(vec @ vec))
                 if r < 1e-12:
-                    total += -4.0 * xi / math.sqrt(math.pi) / (8.0 * math.pi)
+                    total += -4.0 * xi / root_pi / (8.0 * math.pi) * np.eye(3)
                     continue
                 e = math.exp(-(xi * r) ** 2)
                 c = float(erfc(xi * r))
-                real = (c / r - 2.0 * xi * e / math.sqrt(math.pi)
-                        + (vec[0] / r) ** 2 * (c / r + 2.0 * xi * e / math.sqrt(math.pi)))
-                total += real / (8.0 * math.pi)
-    if np.linalg.norm(r0) > 1e-12:
-        r = float(np.linalg.norm(r0))
-        total -= (1.0 + (r0[0] / r) ** 2) / (8.0 * math.pi * r)
+                total += (np.eye(3) * (c / r - 2.0 * xi * e / root_pi)
+                          + np.outer(vec, vec) / r ** 2 * (c / r + 2.0 * xi * e / root_pi)
+                          ) / (8.0 * math.pi)
+    r = float(np.linalg.norm(r0))
+    if r > 1e-12:
+        total -= (np.eye(3) + np.outer(r0, r0) / r ** 2) / (8.0 * math.pi * r)
     n = np.arange(-waves, waves + 1)
-    kx, ky, kz = np.meshgrid(*(2.0 * math.pi * n / length for length in box), indexing="ij")
-    k2 = kx ** 2 + ky ** 2 + kz ** 2
+    wave = np.meshgrid(*(2.0 * math.pi * n / length for length in box), indexing="ij")
+    k2 = sum(component ** 2 for component in wave)
     k2[waves, waves, waves] = 1.0
-    weight = (1.0 - kx ** 2 / k2) * (1.0 + k2 / (4 * xi * xi)) * np.exp(-k2 / (4 * xi * xi)) / k2
+    weight = (1.0 + k2 / (4 * xi * xi)) * np.exp(-k2 / (4 * xi * xi)) / k2
     weight[waves, waves, waves] = 0.0
-    phase = np.cos(kx * r0[0] + ky * r0[1] + kz * r0[2])
-    total += float(np.sum(weight * phase)) / float(np.prod(box))
+    weight *= np.cos(wave[0] * r0[0] + wave[1] * r0[1] + wave[2] * r0[2])
+    for a in range(3):
+        for b in range(3):
+            projector = float(a == b) - wave[a] * wave[b] / k2
+            total[a, b] += float(np.sum(weight * projector)) / float(np.prod(box))
     return total
+
+
+def periodic_oseen_xx(displacement, box, **kwargs) -> float:
+    """The xx component of :func:`periodic_oseen` [h⁻¹]."""
+    return float(periodic_oseen(displacement, box, **kwargs)[0, 0])
 
 
 def periodic_self_coefficient(box) -> float:
@@ -254,27 +174,48 @@ def _batchelor_a(distance_over_radius):
     return np.clip(np.maximum(series, 1.0 - 4.077 * (rho - 2.0)), 0.0, 1.0)
 
 
-def image_mobility(gap, radius: float, box) -> np.ndarray:
-    """Δ of the module docstring (dimensionless, in units of 1/(6πμa)) for the squeeze mode of
-    two spheres on a line parallel to x at surface gap ``gap`` [h]."""
+def image_mobility(gap, radius: float, box, *, angle=0.0, mode: str = "squeeze") -> np.ndarray:
+    """Δ of the module docstring (dimensionless, in units of 1/(6πμa)) for two spheres at
+    surface gap ``gap`` [h] on a line in the xy plane at ``angle`` [rad] from x (one angle, or
+    one per gap). ``mode`` "squeeze": relative motion along the line, suppressed near contact
+    by 1 − A(r); "sliding": relative motion normal to it in the xy plane, unsuppressed
+    [choice: Batchelor & Green's B(r) is not used, so Δ is an upper bound there]."""
     gap = np.atleast_1d(np.asarray(gap, dtype=float))
-    self_part = periodic_oseen_xx(np.zeros(3), box)
+    angle = np.broadcast_to(np.asarray(angle, dtype=float), gap.shape)
+    self_part = periodic_oseen(np.zeros(3), box)
     out = np.empty_like(gap)
-    for i, s in enumerate(gap):
-        r = 2.0 * radius + s
-        cross = periodic_oseen_xx(np.array([r, 0.0, 0.0]), box)
-        out[i] = 6.0 * math.pi * radius * (self_part - cross)
-    return out * (1.0 - _batchelor_a(2.0 + gap / radius))
+    for i, (s, theta) in enumerate(zip(gap, angle)):
+        line = np.array([math.cos(theta), math.sin(theta), 0.0])
+        motion = line if mode == "squeeze" else np.array([-line[1], line[0], 0.0])
+        cross = periodic_oseen((2.0 * radius + s) * line, box)
+        out[i] = 6.0 * math.pi * radius * motion @ (self_part - cross) @ motion
+    if mode == "squeeze":
+        out *= 1.0 - _batchelor_a(2.0 + gap / radius)
+    return out
 
 
-def squeeze_theory(gap, radius: float, viscosity: float, speed: float, box=None):
+def squeeze_theory(gap, radius: float, viscosity: float, speed: float, box=None, *,
+                   angle=0.0):
     """Squeeze force [m h τ⁻²] on each of two equal spheres of ``radius`` [h] at surface
     ``gap`` [h] moving at ±``speed`` [h τ⁻¹]: 6πμaU/(m + Δ), m = 1/(X11A − X12A) (JO 1984),
-    Δ the periodic-image term of ``box`` (None: free space)."""
+    Δ the periodic-image term of ``box`` (None: free space) for the pair at ``angle``."""
     gap = np.asarray(gap, dtype=float)
     mobility = 1.0 / squeeze_resistance(gap, radius)
     if box is not None:
-        mobility = mobility + image_mobility(gap, radius, box).reshape(gap.shape)
+        mobility = mobility + image_mobility(gap, radius, box, angle=angle).reshape(gap.shape)
+    return 6.0 * math.pi * viscosity * radius * speed / mobility
+
+
+def sliding_theory(gap, radius: float, viscosity: float, speed: float, box=None, *,
+                   angle=0.0):
+    """Sliding force [m h τ⁻²] on each of two equal spheres, held from turning, moving at
+    ±``speed`` [h τ⁻¹] normal to their line of centres: 6πμaU/(m + Δ), m = 1/(Y11A − Y12A),
+    Δ as in :func:`squeeze_theory` for the sliding mode."""
+    gap = np.asarray(gap, dtype=float)
+    mobility = 1.0 / sliding_resistance(gap, radius)
+    if box is not None:
+        mobility = mobility + image_mobility(gap, radius, box, angle=angle,
+                                             mode="sliding").reshape(gap.shape)
     return 6.0 * math.pi * viscosity * radius * speed / mobility
 
 
@@ -309,17 +250,28 @@ def _speed(radius, viscosity, reynolds, number_density):
     return reynolds * viscosity / (number_density * radius)
 
 
+def _pair_frame(centres):
+    """Unit vectors along the line from body 0 to body 1 and normal to it in the xy plane."""
+    line = centres[1] - centres[0]
+    line = line / math.sqrt(line @ line)
+    return line, np.array([-line[1], line[0], 0.0])
+
+
 def squeeze_run(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float = 1.0,
                 reynolds: float = REYNOLDS, start_gap: float | None = None,
                 end_gap: float = 0.05, sound_speed: float = SOUND_SPEED,
                 number_density: float = 4.096, threads: int = 1,
-                numerics: dict | None = None) -> dict:
+                numerics: dict | None = None, slide_ratio: float = 0.0) -> dict:
     """Raw time series of the prescribed approach (module docstring); ``numerics`` scene
     keys over the runs' own (e.g. ``{"spin_correction": True}``).
 
-    The speed of each sphere is U = Re μ/(ρ_f a). ``start_gap`` default 2a + 2 h. Returns a
-    dict of arrays ``gap`` (nominal, [h]) and ``force`` (squeeze force, [m h τ⁻²]) per step,
-    and scalars (speed, dt, n_particles, wall_time_s, health).
+    The speed of each sphere is U = Re μ/(ρ_f a) along the line of centres. With
+    ``slide_ratio`` k > 0 the spheres also slide past each other at ±kU normal to the line, in
+    the xy plane (the line turns as they pass; k = 1 is the relative motion of a pair at 45°
+    in the compressional quadrant of a simple shear). ``start_gap`` default 2a + 2 h. Returns
+    a dict of arrays ``gap`` (nominal, [h]), ``force`` (squeeze force, [m h τ⁻²]),
+    ``sliding_force`` (the force resisting the sliding, [m h τ⁻²]) and ``angle`` (of the line
+    from x, [rad]) per step, and scalars (speed, dt, n_particles, wall_time_s, health).
     """
     box = np.asarray(box, dtype=float)
     start_gap = 2.0 * radius + 2.0 if start_gap is None else float(start_gap)
@@ -335,20 +287,25 @@ def squeeze_run(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float
                                   number_density=number_density,
                                   shifting_rate=speed / radius, numerics=numerics)
         sim = Simulation(scene, threads=threads)
-    motion = np.array([[speed, 0.0, 0.0], [-speed, 0.0, 0.0]])
     still = np.zeros((2, 3))
-    distance = 2.0 * half
     steps = int(math.floor((start_gap - end_gap) / (2.0 * speed * sim.dt)))
-    gaps, forces = np.empty(steps), np.empty(steps)
+    gaps, forces, sliding, angles = (np.empty(steps) for _ in range(4))
     for k in range(steps):
-        sim.bodies.set_motion(motion, still)
+        line, normal = _pair_frame(sim.bodies.centres)
+        velocity = speed * (line - slide_ratio * normal)
+        sim.bodies.set_motion(np.array([velocity, -velocity]), still)
         sim.advance(1)
-        distance -= 2.0 * speed * sim.dt
-        gaps[k] = distance - 2.0 * radius
-        forces[k] = 0.5 * (sim.bodies.forces[1, 0] - sim.bodies.forces[0, 0])
+        line, normal = _pair_frame(sim.bodies.centres)
+        relative = sim.bodies.centres[1] - sim.bodies.centres[0]
+        difference = sim.bodies.forces[1] - sim.bodies.forces[0]
+        gaps[k] = math.sqrt(relative @ relative) - 2.0 * radius
+        forces[k] = 0.5 * difference @ line
+        sliding[k] = -0.5 * difference @ normal
+        angles[k] = math.atan2(line[1], line[0])
     ok, message = sim.health()
     lub = sim.scene.inclusions.lubrication
-    return {"gap": gaps, "force": forces, "speed": speed, "dt": sim.dt,
+    return {"gap": gaps, "force": forces, "sliding_force": sliding, "angle": angles,
+            "slide_ratio": float(slide_ratio), "speed": speed, "dt": sim.dt,
             "lubrication_cutoff_gap": lub.cutoff_gap, "lubrication_min_gap": lub.min_gap,
             "n_particles": sim.n_particles, "n_body_particles": sim.n_body_particles,
             "wall_time_s": wallclock.perf_counter() - started, "health": message,
@@ -438,14 +395,15 @@ def squeeze_dataset(run: dict, drag: dict, radius: float, box, *, viscosity: flo
     box = np.asarray(box, dtype=float)
     edges = gap_edges(radius, end_gap, per_decade)
     centre, mean, error = bin_series(run["gap"], run["force"], edges)
+    angle = bin_series(run["gap"], run["angle"], edges)[1]
     keep = np.isfinite(mean)
-    centre, mean, error = centre[keep], mean[keep], error[keep]
+    centre, mean, error, angle = centre[keep], mean[keep], error[keep], angle[keep]
     speed, a_h = run["speed"], drag["hydrodynamic_radius"]
     distance = centre + 2.0 * radius
     gap_h = distance - 2.0 * a_h
     theory_h = np.where(gap_h > 0, squeeze_theory(np.maximum(gap_h, 1e-9), a_h, viscosity,
-                                                  speed, box), np.nan)
-    theory = squeeze_theory(centre, radius, viscosity, speed, box)
+                                                  speed, box, angle=angle), np.nan)
+    theory = squeeze_theory(centre, radius, viscosity, speed, box, angle=angle)
     free_h = np.where(gap_h > 0, squeeze_theory(np.maximum(gap_h, 1e-9), a_h, viscosity, speed),
                       np.nan)
     lubrication = lubrication_correction(centre, radius, viscosity, speed,
@@ -474,6 +432,23 @@ def squeeze_dataset(run: dict, drag: dict, radius: float, box, *, viscosity: flo
         "normalised_force": ("gap", mean / (6 * math.pi * viscosity * radius * speed),
                              {"units": "1", "long_name": "F_SPH / (6 pi mu a U)"}),
     }
+    slide_ratio = run.get("slide_ratio", 0.0)
+    if slide_ratio > 0:
+        sliding = bin_series(run["gap"], run["sliding_force"], edges)[1][keep]
+        sliding_speed = slide_ratio * speed
+        theory_sliding = sliding_theory(centre, radius, viscosity, sliding_speed, box,
+                                        angle=angle)
+        data.update({
+            "sliding_force": ("gap", sliding, {**force_units, "long_name": "SPH force "
+                              "resisting the sliding, bin mean"}),
+            "theory_sliding_force": ("gap", theory_sliding, {**force_units, "long_name":
+                                     "Jeffrey-Onishi sliding force with radius a, periodic "
+                                     "images"}),
+            "ratio_sliding": ("gap", sliding / theory_sliding, {"units": "1", "long_name":
+                              "F_SPH,sliding / F_theory,sliding(a)"}),
+            "angle": ("gap", angle, {"units": "rad", "long_name": "line of centres from x, "
+                      "bin mean"}),
+        })
     ds = xr.Dataset(data, coords={"gap": ("gap", centre, {**length,
                                   "long_name": "nominal surface gap r - 2a, bin mean"})})
     ds.attrs.update({
@@ -487,7 +462,9 @@ def squeeze_dataset(run: dict, drag: dict, radius: float, box, *, viscosity: flo
         "sound_speed": run["sound_speed"], "start_gap": run["start_gap"],
         "n_particles": run["n_particles"], "squeeze_wall_time_s": run["wall_time_s"],
         "drag_wall_time_s": drag["wall_time_s"], "health": run["health"],
-        "motion": "prescribed: body velocities reset to +-U x before every step",
+        "motion": ("prescribed: body velocities reset before every step to +-U along the "
+                   f"line of centres and -+{slide_ratio:g} U normal to it in the xy plane"),
+        "slide_ratio": slide_ratio,
         "cutoff_gap": cutoff_gap(centre, mean / theory),
         "lubrication_cutoff_gap": run["lubrication_cutoff_gap"],
         "lubrication_min_gap": run["lubrication_min_gap"], **provenance()})
