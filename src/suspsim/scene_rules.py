@@ -128,16 +128,22 @@ AUTO_SHIFTING_NON_NEWTONIAN = 3.0
 #: numerics.spin_correction, by shifting coefficient A [choice]: the largest gap at which the
 #: resolved two-sphere squeeze force falls below 0.9 of Jeffrey–Onishi
 #: (``validation.squeeze.cutoff_gap``; a = 2.5 h, Re = 0.05, docs/figures/make_squeeze.py
-#: --set numerics.spin_correction=true --set numerics.shifting=A). Other A interpolate in log A
-#: and hold the end values beyond. Stronger shifting resolves the squeeze to closer gaps, and a
-#: larger cutoff would count the resolved force twice.
-AUTO_CUTOFF_GAP_CORRECTED = ((3.0, 0.58), (30.0, 0.185), (100.0, 0.14))
+#: --no-large --set numerics.shifting=A), the larger of two motions: a pure approach (0.58, 0.185
+#: and 0.14 h) and an approach while sliding at the same speed (``--slide 1``, a pair at 45° in a
+#: shear's compressional quadrant: 0.58, 0.328 and 0.328 h). A sheared pair both approaches and
+#: slides, and the correction must cover every gap where either motion's resolved force falls
+#: short; the sliding force itself never does (0.98–1.6 × Y^A). Other A interpolate in log A and
+#: hold the end values beyond. A larger cutoff would count the resolved force twice.
+AUTO_CUTOFF_GAP_CORRECTED = ((3.0, 0.58), (30.0, 0.328), (100.0, 0.328))
 #: The same with shifting tangential at the bodies (numerics.shifting_at_bodies; make_squeeze.py
-#: --no-large --set numerics.shifting=A --set numerics.shifting_at_bodies='"tangential"').
-AUTO_CUTOFF_GAP_TANGENTIAL = ((3.0, 0.437), (30.0, 0.246), (100.0, 0.185))
-#: The same without the spin correction (A = 30; the resolved force stays within 10 % of
-#: Jeffrey–Onishi down to 0.58 h).
-AUTO_CUTOFF_GAP_UNCORRECTED = 0.6
+#: --no-large [--slide 1] --set numerics.shifting=A
+#: --set numerics.shifting_at_bodies='"tangential"'): approach 0.437, 0.246 and 0.185 h, while
+#: sliding —, 0.328 and 0.185 h (at A = 3 the squeeze while sliding reads 0.85–0.95 of the
+#: nominal theory from 0.44 h out to 2.5 h, a_h/a = 0.96, so it sets no cutoff).
+AUTO_CUTOFF_GAP_TANGENTIAL = ((3.0, 0.437), (30.0, 0.328), (100.0, 0.185))
+#: The same without the spin correction (A = 30): approach 0.6 h, while sliding 0.778 h (the
+#: squeeze reads 0.89 there and at 0.58 h, 0.94–1.02 at 1–1.8 h).
+AUTO_CUTOFF_GAP_UNCORRECTED = 0.778
 
 
 def _resolve_cutoff(inclusions: dict, numerics: dict) -> dict:

@@ -218,9 +218,10 @@ def test_torque_free_sphere_turns_with_the_fluid():
 
 
 @pytest.mark.xfail(strict=True, reason="frictionless dense spheres read below the fits "
-                   "(5.61-8.78 at phi = 0.4): with the spin correction and its cutoff 0.185 h "
-                   "3.85, 4.31 (15 h box, seeds 1/2, strain 1 + 8; README); contact friction "
-                   "puts them inside (the frictional test below; issue 4)")
+                   "(5.61-8.78 at phi = 0.4): with the spin correction and its cutoff 0.328 h "
+                   "4.51, 4.59 (16.875 h box, seeds 1/2, strain 1 + 4; 0.185 h: 3.85, 4.31 in "
+                   "this 15 h box, strain 1 + 8; README); contact friction puts them inside "
+                   "(the frictional test below; issue 4)")
 @pytest.mark.xdist_group("dense")
 def test_dense_suspension_inside_published_envelope():
     """REFERENCE_NUMBERS §2a: the min–max of the experimental fits, 5.61–8.78 at φ = 0.4."""
@@ -242,10 +243,10 @@ def _envelope_check(phi, box, seeds, overrides=None):
 
 
 PHI_03_BELOW = pytest.mark.xfail(strict=True, reason=(
-    "frictionless spheres at phi = 0.3 read 2.981, 2.793, 2.744, 2.513 (seeds 1-4, mean 2.758) "
-    "against 2.90-3.93 with the spin correction and its cutoff 0.185 h (with the cutoff 0.6 h, "
-    "which counts the resolved squeeze twice: 3.45, 2.95); mu_c = 0.5 reads 3.56, 3.20 (README; "
-    "issue 4)"))
+    "frictionless spheres at phi = 0.3 read 3.204, 2.865, 2.717, 2.584 (seeds 1-4, mean 2.842) "
+    "against 2.90-3.93 with the spin correction and its cutoff 0.328 h (0.185 h: mean 2.758; "
+    "0.6 h, which counts the resolved squeeze twice: 3.45, 2.95); mu_c = 0.5 reads 3.56, 3.20 "
+    "(README; issue 4)"))
 
 
 @pytest.mark.parametrize("phi, seeds", [
@@ -253,14 +254,16 @@ PHI_03_BELOW = pytest.mark.xfail(strict=True, reason=(
     pytest.param(0.3, (1, 2, 3, 4), marks=[FULL_SIZE, PHI_03_BELOW])])
 def test_spheres_inside_published_envelope(phi, seeds):
     """Frictionless Newtonian spheres a = 2.5 h with the defaults (spin correction and its
-    squeeze cutoff 0.185 h) in a 15 h box (strain 1 + 4): the mean η_r of the packing ``seeds``
+    squeeze cutoff 0.328 h) in a 15 h box (strain 1 + 4): the mean η_r of the packing ``seeds``
     inside the min–max of the experimental fits (REFERENCE_NUMBERS §2a), where the uncorrected
     form reads 5–25 % below it. φ = 0.3 reads below (the mark); its packings scatter by ±9 %,
     so it takes four.
 
-    Measured (2026-12-06 evening): φ = 0.1: 1.335 ± 0.006, 1.303 ± 0.007 (mean 1.319) against
-    1.316–1.435 (Batchelor & Green 1.302); φ = 0.2: 1.930 ± 0.034, 1.876 ± 0.017 against
-    1.851–2.232. With μ_c = 0.5 as well: 1.337, 1.306; 2.044, 2.015; 3.56, 3.20 at φ = 0.3."""
+    Measured (2026-12-07, one thread, ``make_shape_seeds.py --box 15``): φ = 0.1: 1.334 ±
+    0.009, 1.307 ± 0.006 (mean 1.320) against 1.316–1.435 (Batchelor & Green 1.302); φ = 0.2:
+    1.951 ± 0.045, 1.894 ± 0.020 against 1.851–2.232 (with the cutoff 0.185 h: 1.335, 1.303;
+    1.930, 1.876). With μ_c = 0.5 as well (0.185 h): 1.337, 1.306; 2.044, 2.015; 3.56, 3.20 at
+    φ = 0.3."""
     _envelope_check(phi, 15.0, seeds)
 
 
