@@ -17,9 +17,9 @@ so that μ_m(γ̇_sim) = 1 [m h^-1 τ^-1] at every x and the particle Reynolds n
 The Newtonian reference is μ = 1, run with the numerics the Papanastasiou runs take by default
 (``numerics.shifting`` = :data:`~suspsim.scene_rules.AUTO_SHIFTING_NON_NEWTONIAN`, and the
 lubrication cutoff that follows it): the estimate then compares one numerical model in two
-matrices. With the Newtonian defaults (A = 30, cutoff 0.185 h) the same packing read g = 3.86
-± 0.09 against 5.01 ± 0.07 for the Papanastasiou run at x = 0.01, whose matrix is Newtonian at
-that rate (2026-12-06). A run's relative viscosity η/μ_m(γ̇_sim) is then its
+matrices. With the Newtonian defaults of then (A = 30, cutoff 0.185 h) the same packing read
+g = 3.86 ± 0.09 against 5.01 ± 0.07 for the Papanastasiou run at x = 0.01, whose matrix is
+Newtonian at that rate (2026-12-06). A run's relative viscosity η/μ_m(γ̇_sim) is then its
 suspension viscosity in simulation units, and η/μ_pl = η_r μ_m/μ_pl with
 μ_m/μ_pl = 1 + r (1 − e^(−x))/x (:func:`matrix_plastic_ratio`).
 
