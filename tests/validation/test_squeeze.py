@@ -50,7 +50,7 @@ def test_xa_far_field_matches_the_reflection_series():
 
 
 def test_jeffrey_onishi_sliding_coefficients_match_the_tabulated_ones():
-    # f_k(λ) of JO Eq. 4.12: 1, 3λ/2, 9λ/4, 2λ + 27λ²/8 + 2λ³, 6λ + 81λ²/16 + 18λ³
+    # f_k(λ) of Y^A (JO §4): 1, 3λ/2, 9λ/4, 2λ + 27λ²/8 + 2λ³, 6λ + 81λ²/16 + 18λ³
     np.testing.assert_allclose(ya_coefficients(1.0, 4), [1, 1.5, 2.25, 7.375, 29.0625],
                                rtol=1e-12)
     lam = 0.5
@@ -66,7 +66,7 @@ def test_ya_near_contact_and_far_field_match_the_published_limits():
         y11, y12 = ya_functions(np.array([2.0 + xi]))
         assert y11[0] == pytest.approx(math.log(1 / xi) / 6 + 0.9983, abs=2e-3)
         assert y12[0] == pytest.approx(-math.log(1 / xi) / 6 - 0.2737, abs=2e-3)
-    # Far field, t = r/a: Y11A = Σ f_2k/(2t)^2k, Y12A = −Σ f_2k+1/(2t)^2k+1 (JO 4.13–4.14).
+    # Far field, t = r/a: Y11A = Σ f_2k/(2t)^2k, Y12A = −Σ f_2k+1/(2t)^2k+1 (as JO 3.13–3.14).
     t = 20.0
     f = ya_coefficients(1.0, 5)
     y11, y12 = ya_functions(np.array([t]))

@@ -132,7 +132,7 @@ def xa_coefficients(size_ratio: float = 1.0, terms: int = SERIES_TERMS) -> np.nd
 
 @functools.lru_cache(maxsize=4)
 def ya_coefficients(size_ratio: float = 1.0, terms: int = SERIES_TERMS) -> np.ndarray:
-    """f_k(λ) of Y^A, k = 0 … terms (JO Eq. 4.12)."""
+    """f_k(λ) of Y^A, k = 0 … terms (defined as JO Eq. 3.15, from the Y^A recurrence)."""
     return _coefficients(_ya_table(terms), size_ratio, terms)
 
 
