@@ -279,7 +279,8 @@ def test_frictional_dense_spheres_inside_published_envelope(phi):
 
     Measured (2026-12-06, with the spin correction and its cutoff): φ = 0.4: 6.92 ± 0.87,
     7.61 ± 0.36 against 5.61–8.78; φ = 0.5: 35.6 ± 2.0, 38.7 ± 4.5 against 17.7–42.8. Without
-    the correction: 5.77 ± 0.57, 8.16 ± 0.71 and 28.3 ± 1.5, 45.7 ± 4.9."""
+    the correction: 5.77 ± 0.57, 8.16 ± 0.71 and 28.3 ± 1.5, 45.7 ± 4.9. With the cutoff 0.328 h
+    (2026-12-07, ``make_shape_seeds.py``): 7.65 ± 1.13, 7.73 ± 0.57 and 33.9 ± 5.3, 32.4 ± 3.5."""
     _envelope_check(phi, 16.875, (1, 2), {"inclusions.lubrication.friction": 0.5})
 
 
