@@ -251,10 +251,12 @@ def _speed(radius, viscosity, reynolds, number_density):
 
 
 def _pair_frame(centres):
-    """Unit vectors along the line from body 0 to body 1 and normal to it in the xy plane."""
+    """(d, n, r): the unit vector along the line from body 0 to body 1, the unit normal to it in
+    the xy plane, and the centre distance r [h]."""
     line = centres[1] - centres[0]
-    line = line / math.sqrt(line @ line)
-    return line, np.array([-line[1], line[0], 0.0])
+    distance = math.sqrt(line @ line)
+    line = line / distance
+    return line, np.array([-line[1], line[0], 0.0]), distance
 
 
 def squeeze_run(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float = 1.0,
@@ -291,14 +293,13 @@ def squeeze_run(radius: float = 2.5, box=(25.0, 17.5, 17.5), *, viscosity: float
     steps = int(math.floor((start_gap - end_gap) / (2.0 * speed * sim.dt)))
     gaps, forces, sliding, angles = (np.empty(steps) for _ in range(4))
     for k in range(steps):
-        line, normal = _pair_frame(sim.bodies.centres)
+        line, normal, _ = _pair_frame(sim.bodies.centres)
         velocity = speed * (line - slide_ratio * normal)
         sim.bodies.set_motion(np.array([velocity, -velocity]), still)
         sim.advance(1)
-        line, normal = _pair_frame(sim.bodies.centres)
-        relative = sim.bodies.centres[1] - sim.bodies.centres[0]
+        line, normal, distance = _pair_frame(sim.bodies.centres)
         difference = sim.bodies.forces[1] - sim.bodies.forces[0]
-        gaps[k] = math.sqrt(relative @ relative) - 2.0 * radius
+        gaps[k] = distance - 2.0 * radius
         forces[k] = 0.5 * difference @ line
         sliding[k] = -0.5 * difference @ normal
         angles[k] = math.atan2(line[1], line[0])
