@@ -39,8 +39,8 @@ from . import harmonics as sh
 from .shapes import mass_properties, radius_bounds
 
 __all__ = ["DEFAULT_DEGREE", "DEFAULT_ELONGATION_RANGE", "DEFAULT_ROUGHNESS",
-           "DEFAULT_SPECTRAL_EXPONENT", "elongation_and_flatness", "principal_frame",
-           "random_grain"]
+           "DEFAULT_SPECTRAL_EXPONENT", "ellipsoid_coefficients", "elongation_and_flatness",
+           "principal_frame", "random_grain"]
 
 DEFAULT_DEGREE = 20
 DEFAULT_SPECTRAL_EXPONENT = 2.2
@@ -112,6 +112,15 @@ def _random_phase_coefficients(rng, degree: int) -> np.ndarray:
     out[degree + 1:] = np.cos(psi[1:])
     out[:degree] = np.sin(psi[1:])[::-1]
     return out
+
+
+def ellipsoid_coefficients(axes, radius: float, degree: int = DEFAULT_DEGREE) -> np.ndarray:
+    """Degree-``degree`` coefficients of the ellipsoid with semi-axes proportional to ``axes``
+    along x, y, z and volume-equivalent ``radius`` [length]: a grain's base shape (step 1 of
+    the module docstring) without roughness, e.g. the spheroid of ``validation.jeffery``."""
+    axes = np.asarray(axes, dtype=float)
+    unit = _ellipsoid_coefficients(axes / np.cbrt(axes.prod()), _surface_grid(degree))
+    return unit * radius * (_UNIT_VOLUME / mass_properties(unit).volume) ** (1.0 / 3.0)
 
 
 def _ellipsoid_coefficients(axes, grid: sh.GaussGrid) -> np.ndarray:
