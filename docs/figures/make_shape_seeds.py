@@ -11,10 +11,11 @@ each. η_r = σ_xy/(μγ̇) is averaged over whole strain units after the transi
 the packings' η_r gives the error of their mean, and sand/spheres is the ratio of the means
 (errors in quadrature). Beside η_r each run reports η_r^p = 1 + σ^p_xy/(μγ̇) from the bodies'
 share of the stress alone (Batchelor 1970; ``run._batchelor_split``), which leaves out the
-discrete fluid's error, and its health: the largest density
-error, the smallest gap between surfaces [h] and the largest body speed relative to the flow
-over the wall speed, all over the samples; a run that leaves its health limits stops at that
-sample with the reason, is reported and left out of the means. ``--box`` takes another side
+discrete fluid's error, and its health: the largest density error, the smallest gap between
+surfaces [h] and the largest body speed relative to the flow over the wall speed, all over the
+samples; and, after the transient, the bodies' mean spin Ω_z/(−γ̇/2) and the nematic order S of
+the grains' long axes (``analysis.orientation``). A run that leaves its health limits stops at
+that sample with the reason, is reported and left out of the means. ``--box`` takes another side
 (a multiple of the lattice spacing 0.625 h, see ``scene_rules.lattice_mismatch``). One thread
 per run; prints a Markdown table and writes nothing else.
 """
@@ -47,8 +48,8 @@ def main() -> None:
     settings = overrides_text(overrides)
     print(f"φ = {args.phi}, box {args.box} h, a = {RADIUS} h, μ = 1, γ̇ = {RATE}, strain "
           f"{transient:g} + {units}{settings}\n| shape | seed | η_r | η_r^p | CPU [s] | "
-          f"density error | smallest gap [h] | body speed / wall speed |\n"
-          f"|---|---|---|---|---|---|---|---|",
+          f"density error | smallest gap [h] | body speed / wall speed | spin | order S |\n"
+          f"|---|---|---|---|---|---|---|---|---|---|",
           flush=True)
     for shape in args.shapes:
         values = []
@@ -60,18 +61,18 @@ def main() -> None:
                                        overrides=overrides)
             except NumericalError as err:
                 print(f"| {shape} | {seed} | stopped: {err} | | "
-                      f"{time.process_time() - started:.0f} | | | |", flush=True)
+                      f"{time.process_time() - started:.0f} | | | | | |", flush=True)
                 continue
             values.append(r.relative_viscosity)
             print(f"| {shape} | {seed} | {r.relative_viscosity:.3f} ± {r.stderr:.3f} | "
                   f"{r.particle_relative_viscosity:.3f} ± {r.particle_stderr:.3f} | "
                   f"{r.cpu_time:.0f} | {r.density_error:.3f} | {r.smallest_gap:.3f} | "
-                  f"{r.body_speed:.2f} |", flush=True)
+                  f"{r.body_speed:.2f} | {r.spin:.2f} | {r.order:.2f} |", flush=True)
         if not values:
             continue
         sem = np.std(values, ddof=1) / math.sqrt(len(values)) if len(values) > 1 else math.nan
         means[shape] = (float(np.mean(values)), float(sem))
-        print(f"| {shape} | mean | {means[shape][0]:.3f} ± {means[shape][1]:.3f} | | | | | |",
+        print(f"| {shape} | mean | {means[shape][0]:.3f} ± {means[shape][1]:.3f} | | | | | | | |",
               flush=True)
     if "sphere" in means and "sand" in means:
         (s, ds), (g, dg) = means["sphere"], means["sand"]

@@ -15,6 +15,7 @@ from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
 import numpy as np
 
+from suspsim.analysis.orientation import nematic_order, spin_ratio
 from suspsim.bodies.lubrication_pass import SMALLEST_GAP
 from suspsim.errors import NumericalError
 from suspsim.scene import Scene, scene_from_dict
@@ -36,7 +37,9 @@ class SuspensionReading(NamedTuple):
     the largest body speed relative to the imposed flow, ``body_speed``, in units of the wall
     speed γ̇L_y/2 [1]; ``particle_relative_viscosity`` 1 + σ^p_xy/(μγ̇) from the bodies' share
     of the stress alone (Batchelor 1970; ``run._batchelor_split``) and its ``particle_stderr``
-    [1]."""
+    [1]; over the samples after the transient, the bodies' mean ``spin`` Ω_z/(−γ̇/2) and, for
+    sand, the nematic ``order`` S of their long axes (nan for spheres) [1]
+    (``analysis.orientation``)."""
 
     relative_viscosity: float
     stderr: float
@@ -48,14 +51,27 @@ class SuspensionReading(NamedTuple):
     body_speed: float
     particle_relative_viscosity: float
     particle_stderr: float
+    spin: float
+    order: float
 
 
 class HealthWatch:
     """The health extremes of a run, updated at each sample; stops the run (NumericalError
-    with the simulation's reason) at the first sample outside its health limits."""
+    with the simulation's reason) at the first sample outside its health limits. Also keeps
+    each sample's strain, the bodies' spin ratio and, for sand, the nematic order of their long
+    axes (``analysis.orientation``; :meth:`steady_means`)."""
 
     def __init__(self) -> None:
         self.density_error, self.smallest_gap, self.body_speed = 0.0, math.inf, 0.0
+        self.samples: list[tuple[float, float, float]] = []
+
+    def steady_means(self, transient: float) -> tuple[float, float]:
+        """(spin ratio, nematic order) averaged over the samples after the strain
+        ``transient`` (nan without such samples; the order is nan for spheres)."""
+        rows = np.array([row for row in self.samples if row[0] > transient + 1e-9])
+        if len(rows) == 0:
+            return math.nan, math.nan
+        return float(rows[:, 1].mean()), float(rows[:, 2].mean())
 
     def __call__(self, sim: Simulation) -> None:
         ok, message = sim.health()
@@ -72,6 +88,10 @@ class HealthWatch:
         wall_speed = 0.5 * scene.flow.shear_rate * scene.box[1]
         self.body_speed = max(self.body_speed,
                               float(np.sqrt((peculiar ** 2).sum(axis=1)).max()) / wall_speed)
+        order = (nematic_order(bodies.rotations()[:, :, 0])[0]
+                 if scene.inclusions.shape == "sand" else math.nan)
+        self.samples.append((sim.strain, spin_ratio(bodies.angular_velocities(),
+                                                    scene.flow.shear_rate), order))
 
 
 def add_run_options(parser: argparse.ArgumentParser, *, units: float = 4.0,
@@ -137,7 +157,7 @@ def relative_viscosity(*, shape: str = "sphere", phi: float, radius: float, box:
     return SuspensionReading(total.value, total.stderr, time.process_time() - started,
                              sim.n_particles, sim.packing_phi, watch.density_error,
                              watch.smallest_gap, watch.body_speed, 1.0 + particle.value,
-                             particle.stderr)
+                             particle.stderr, *watch.steady_means(transient))
 
 
 def sampled_run(scene: Scene, *, transient: float, units: float) -> Iterator[Simulation]:
