@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from suspsim.analysis.orientation import nematic_order, spin_ratio
+from suspsim.analysis.orientation import nematic_order
 from suspsim.bodies.lubrication_pass import PAIRS
 from suspsim.sph.terms.force_pass import VXY
 from suspsim.validation.suspension import (RATE, add_run_options, overrides_text,
@@ -42,12 +42,12 @@ def main() -> None:
     rows = []
     for sim in sampled_run(scene, transient=transient, units=units):
         scale = float(sim.scene.fluid.law.viscosity(RATE)) * RATE * sim.scene.volume
+        sample = sim.sample()
         order, director = nematic_order(sim.bodies.rotations()[:, :, 0])
         director = director if director[0] >= 0.0 else -director
-        rows.append((sim.strain, sim.sample()["shear_stress"] * sim.scene.volume / scale,
+        rows.append((sim.strain, sample["shear_stress"] * sim.scene.volume / scale,
                      -sim._body_virial[VXY] / scale, -sim._lubrication_virial[VXY] / scale,
-                     sim._lubrication_stats[PAIRS],
-                     spin_ratio(sim.bodies.angular_velocities(), RATE), order,
+                     sim._lubrication_stats[PAIRS], sample["body_spin"], order,
                      math.degrees(math.atan2(director[1], director[0]))))
     data = np.array(rows)
     print(f"{args.shape}, φ = {args.phi}, seed {args.seed}, box {args.box} h, a = {RADIUS} h, "

@@ -114,15 +114,17 @@ class Record:
     """The loop's accumulators: time series and profile sums over the steady window.
 
     ``sample_names`` and ``profile_names`` (class attributes) are the registry names kept;
-    a solver with other diagnostics subclasses with its own.
+    ``optional_names`` those kept when the samples have them; a solver with other diagnostics
+    subclasses with its own.
     """
 
     sample_names: tuple[str, ...] = SAMPLE_NAMES
+    optional_names: tuple[str, ...] = ()
     profile_names: tuple[str, ...] = PROFILE_NAMES
 
     def __init__(self, series: dict[str, np.ndarray] | None = None,
                  sums: dict[str, np.ndarray] | None = None, n_profiles: int = 0):
-        names = ("step", "time", "strain", *self.sample_names)
+        names = ("step", "time", "strain", *self.sample_names, *self.optional_names)
         self.series = {k: list((series or {}).get(k, ())) for k in names}
         self.sums = dict(sums or {})
         self.n_profiles = int(n_profiles)
@@ -136,6 +138,16 @@ class Record:
             self.series[name].append(value)
         for name in self.sample_names:
             self.series[name].append(float(scalars[name]))
+        for name in self.optional_names:
+            if name in scalars:
+                self.series[name].append(float(scalars[name]))
+
+    @property
+    def recorded_names(self) -> tuple[str, ...]:
+        """``sample_names`` and the ``optional_names`` every sample had."""
+        return self.sample_names + tuple(name for name in self.optional_names
+                                         if self.series[name]
+                                         and len(self.series[name]) == self.n_samples)
 
     def add_profiles(self, profiles: dict[str, np.ndarray]) -> None:
         self.sums["y"] = np.asarray(profiles["y"], dtype=float)
@@ -157,9 +169,11 @@ class Record:
 
 
 class SuspensionRecord(Record):
-    """A run with inclusions: :class:`Record` with the bodies' share of σ_xy as well."""
+    """A run with inclusions: :class:`Record` with the bodies' share of σ_xy and their spin as
+    well, and the nematic order of grains (``Simulation.sample``)."""
 
-    sample_names = SAMPLE_NAMES + ("particle_stress",)
+    sample_names = SAMPLE_NAMES + ("particle_stress", "body_spin")
+    optional_names = ("body_order",)
 
 
 def run_scene(scene: Scene | str | PathLike, out_path: str | PathLike, *, resume: bool = False,
@@ -344,7 +358,7 @@ def _write_output(out: Path, scene: Scene, sim, record: Record, plan: Plan, wall
                   extra_attrs: dict[str, Any]) -> None:
     series = record.arrays()
     data: dict[str, Any] = {"time": series["time"],
-                            **{k: series[k] for k in record.sample_names}}
+                            **{k: series[k] for k in record.recorded_names}}
     if scene.flow.type == "couette":
         data["strain"] = series["strain"]
         steady = np.array([plan.is_steady(int(s)) for s in series["step"]], dtype=bool)

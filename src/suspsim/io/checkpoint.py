@@ -31,7 +31,8 @@ log = logging.getLogger(__name__)
 FORMAT = "suspsim-checkpoint"
 #: 2: body particles take μ̂ (``viscosity_hat``) from the fluid beside them (2026-12-05).
 #: 3: a run with inclusions records the series ``particle_stress`` (2026-12-06).
-FORMAT_VERSION = 3
+#: 4: and ``body_spin``, with grains ``body_order`` (2026-12-07).
+FORMAT_VERSION = 4
 #: Scene keys that do not change the physics and may differ when a run resumes.
 RESUMABLE_KEYS = (("run", "threads"), ("run", "checkpoint_interval_s"),
                   ("run", "max_density_error"), ("run", "density_outlier_fraction"),

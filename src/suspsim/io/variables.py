@@ -106,6 +106,13 @@ VARIABLES: Mapping[str, Variable] = MappingProxyType({v.name: v for v in (
     Variable("particle_stress", _T, "the bodies' share of sigma_xy: their stresslets plus "
              "lubrication and repulsion, (1/V) sum_B S_B,xy", _STRESS,
              comment="Batchelor, J. Fluid Mech. 41, 545 (1970); SPEC 3.5"),
+    Variable("body_spin", _T, "mean angular velocity Omega_z of the bodies over -shear_rate/2, "
+             "the rate of a free sphere turning with the vorticity",
+             comment="analysis.orientation; an elongated body aligned with the flow turns "
+             "slower (Jeffery 1922)"),
+    Variable("body_order", _T, "nematic order S of the bodies' long axes: the largest "
+             "eigenvalue of <(3 u u - I)/2>, 0 for isotropic axes, 1 for parallel ones (grains "
+             "only)", comment="analysis.orientation"),
     Variable("particle_relative_viscosity", (), "1 + particle_stress/(matrix viscosity x shear "
              "rate) averaged after the transient: relative viscosity from the bodies' share "
              "alone, the fluid's taken at its law (Newtonian matrix only)",

@@ -32,6 +32,7 @@ from typing import Any, NamedTuple
 import numba
 import numpy as np
 
+from suspsim.analysis.orientation import nematic_order, spin_ratio
 from suspsim.bodies.coupling import body_force_torque, place_body_particles
 from suspsim.bodies.grain_contacts import grain_surfaces
 from suspsim.bodies.grain_lubrication_pass import grain_lubrication_pass
@@ -659,7 +660,9 @@ class Simulation:
         density_error, mach (SPEC §2.8); with bodies also particle_stress, the bodies' share
         of σ_xy: their stresslets (the move of the body particles' forces to the centre, SPEC
         §3.5) plus lubrication and repulsion, (1/V) Σ_B S_B,xy of Batchelor (1970) [m h^(2−d)
-        τ⁻²]."""
+        τ⁻²], and body_spin, their mean Ω_z over −γ̇/2 [1]; with grains also body_order, the
+        nematic order S of their long axes [1] (``analysis.orientation``; a sphere's axes are
+        arbitrary)."""
         peculiar = self._peculiar()
         rows = self._virial if self.bodies is None else np.vstack(
             [self._virial, self._body_virial, self._lubrication_virial])
@@ -671,6 +674,9 @@ class Simulation:
         if self.bodies is not None:
             out["particle_stress"] = -float(self._body_virial[VXY]
                                             + self._lubrication_virial[VXY]) / self.scene.volume
+            out["body_spin"] = spin_ratio(self.bodies.angular_velocities(), self._rate)
+            if self._grains is not None:
+                out["body_order"] = nematic_order(self.bodies.rotations()[:, :, 0])[0]
         return out
 
     def profiles(self, bins: int) -> dict[str, np.ndarray]:

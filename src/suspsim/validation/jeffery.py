@@ -32,6 +32,7 @@ from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
+from suspsim.analysis.orientation import spin_ratio
 from suspsim.bodies.grains import DEFAULT_DEGREE, ellipsoid_coefficients
 from suspsim.bodies.packing import Packing
 from suspsim.bodies.shapes import mass_properties, radius_bounds
@@ -122,7 +123,7 @@ def spheroid_run(aspect: float, radius: float, strain: float, *, angle0: float =
     while True:
         axis = sim.bodies.rotations()[0][:, 0]
         rows.append((sim.strain, math.atan2(axis[1], axis[0]), axis[2],
-                     sim.bodies.angular_velocities()[0, 2] / (-0.5 * RATE)))
+                     spin_ratio(sim.bodies.angular_velocities(), RATE)))
         if sim.strain >= strain:
             break
         sim.advance(stride)
