@@ -15,7 +15,6 @@ from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
 import numpy as np
 
-from suspsim.analysis.orientation import nematic_order, spin_ratio
 from suspsim.bodies.lubrication_pass import SMALLEST_GAP
 from suspsim.errors import NumericalError
 from suspsim.scene import Scene, scene_from_dict
@@ -38,7 +37,7 @@ class SuspensionReading(NamedTuple):
     speed γ̇L_y/2 [1]; ``particle_relative_viscosity`` 1 + σ^p_xy/(μγ̇) from the bodies' share
     of the stress alone (Batchelor 1970; ``run._batchelor_split``) and its ``particle_stderr``
     [1]; over the samples after the transient, the bodies' mean ``spin`` Ω_z/(−γ̇/2) and, for
-    sand, the nematic ``order`` S of their long axes (nan for spheres) [1]
+    grains, the nematic ``order`` S of their long axes (nan for spheres) [1]
     (``analysis.orientation``)."""
 
     relative_viscosity: float
@@ -58,8 +57,8 @@ class SuspensionReading(NamedTuple):
 class HealthWatch:
     """The health extremes of a run, updated at each sample; stops the run (NumericalError
     with the simulation's reason) at the first sample outside its health limits. Also keeps
-    each sample's strain, the bodies' spin ratio and, for sand, the nematic order of their long
-    axes (``analysis.orientation``; :meth:`steady_means`)."""
+    each sample's strain, the bodies' spin ratio and, for grains, the nematic order of their
+    long axes (``body_spin``, ``body_order`` of ``Simulation.sample``; :meth:`steady_means`)."""
 
     def __init__(self) -> None:
         self.density_error, self.smallest_gap, self.body_speed = 0.0, math.inf, 0.0
@@ -67,7 +66,7 @@ class HealthWatch:
 
     def steady_means(self, transient: float) -> tuple[float, float]:
         """(spin ratio, nematic order) averaged over the samples after the strain
-        ``transient`` (nan without such samples; the order is nan for spheres)."""
+        ``transient`` (nan without such samples; the order is nan without grains)."""
         rows = np.array([row for row in self.samples if row[0] > transient + 1e-9])
         if len(rows) == 0:
             return math.nan, math.nan
@@ -88,10 +87,9 @@ class HealthWatch:
         wall_speed = 0.5 * scene.flow.shear_rate * scene.box[1]
         self.body_speed = max(self.body_speed,
                               float(np.sqrt((peculiar ** 2).sum(axis=1)).max()) / wall_speed)
-        order = (nematic_order(bodies.rotations()[:, :, 0])[0]
-                 if scene.inclusions.shape == "sand" else math.nan)
-        self.samples.append((sim.strain, spin_ratio(bodies.angular_velocities(),
-                                                    scene.flow.shear_rate), order))
+        scalars = sim.sample()
+        self.samples.append((sim.strain, scalars["body_spin"],
+                             scalars.get("body_order", math.nan)))
 
 
 def add_run_options(parser: argparse.ArgumentParser, *, units: float = 4.0,
