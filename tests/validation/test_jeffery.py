@@ -6,7 +6,7 @@ aspect ratio 2 at two resolutions: the mean turning must follow the vorticity at
 hydrodynamic shape factor λ_h, which the discrete body overestimates (its tips, of curvature
 radius c/r, are about h across), must move towards Jeffery's as the body is resolved finer.
 Full size: a = 2.5 h and 3.75 h, strain 10 (about five minutes on two threads);
-``SUSPSIM_REDUCED=1``: a = 2.5 h alone for the strain 6, through the first alignment (half a
+``SUSPSIM_REDUCED=1``: a = 2.5 h alone for the strain 6, through the first alignment (under a
 minute), which checks the coupling and the plane; the convergence needs the finer body, whose
 run alone takes four minutes.
 """
