@@ -674,9 +674,15 @@ class Simulation:
         if self.bodies is not None:
             out["particle_stress"] = -float(self._body_virial[VXY]
                                             + self._lubrication_virial[VXY]) / self.scene.volume
-            out["body_spin"] = spin_ratio(self.bodies.angular_velocities(), self._rate)
-            if self._grains is not None:
-                out["body_order"] = nematic_order(self.bodies.rotations()[:, :, 0])[0]
+            out.update(self.body_orientation())
+        return out
+
+    def body_orientation(self) -> dict[str, float]:
+        """body_spin, the bodies' mean Ω_z over −γ̇/2, and with grains body_order, the nematic
+        order S of their long axes [1] (``analysis.orientation``; part of :meth:`sample`)."""
+        out = {"body_spin": spin_ratio(self.bodies.angular_velocities(), self._rate)}
+        if self._grains is not None:
+            out["body_order"] = nematic_order(self.bodies.rotations()[:, :, 0])[0]
         return out
 
     def profiles(self, bins: int) -> dict[str, np.ndarray]:

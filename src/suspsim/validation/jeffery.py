@@ -15,7 +15,7 @@ Measurement. :func:`spheroid_run` builds the spheroid from the degree-N spherica
 projection of its radius (:func:`suspsim.bodies.grains.ellipsoid_coefficients`), as sand grains
 are built, puts it at the centre of a periodic Lees–Edwards box in the Newtonian matrix of
 :mod:`suspsim.validation.suspension` (particle Reynolds number ρa²γ̇/μ = 0.1 at a = 2.5 h) and
-records α and the body's Ω_z every 1/20 strain unit. :func:`fit_orbit` fits the measured
+records α every 1/20 strain unit. :func:`fit_orbit` fits the measured
 dα/dγ to −½ (k − λ_h cos 2α): the rotation coupling k is 1 for Jeffery (the mean turning
 follows the vorticity, what the one-sphere spin test checks), and λ_h gives the hydrodynamic
 aspect ratio r_h = √((k + λ_h)/(k − λ_h)) of the discrete body — what a suspension of such
@@ -32,13 +32,12 @@ from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
-from suspsim.analysis.orientation import spin_ratio
 from suspsim.bodies.grains import DEFAULT_DEGREE, ellipsoid_coefficients
 from suspsim.bodies.packing import Packing
 from suspsim.bodies.shapes import mass_properties, radius_bounds
 from suspsim.io.packing_file import write_packing
 from suspsim.sph.simulation import Simulation
-from suspsim.validation.suspension import RATE, suspension_scene
+from suspsim.validation.suspension import NUMBER_DENSITY, RATE, suspension_scene
 
 __all__ = ["OrbitFit", "SpheroidRun", "fit_orbit", "jeffery_angle", "jeffery_lambda",
            "spheroid_box", "spheroid_packing", "spheroid_run"]
@@ -49,7 +48,7 @@ SAMPLES_PER_UNIT = 20
 #: its periodic images are 2.4 lengths apart.
 BOX_PER_RADIUS = 6.0
 #: Lattice spacing of the matrix [h]; box sides are multiples of it (``scene_rules``).
-SPACING = 0.625
+SPACING = NUMBER_DENSITY ** (-1.0 / 3.0)
 
 
 def jeffery_lambda(aspect: float) -> float:
@@ -91,15 +90,12 @@ def spheroid_packing(aspect: float, radius: float, box: float, angle: float,
 
 class SpheroidRun(NamedTuple):
     """Samples of :func:`spheroid_run`: ``strain`` [1], ``angle`` α of the long axis from the
-    flow direction, continuous [rad], ``out_of_plane`` its z component [1], ``spin`` Ω_z over
-    the vorticity's −γ̇/2 [1]; ``n_particles``; ``dt`` [τ]."""
+    flow direction, continuous [rad], ``out_of_plane`` its z component [1]; ``n_particles``."""
 
     strain: np.ndarray
     angle: np.ndarray
     out_of_plane: np.ndarray
-    spin: np.ndarray
     n_particles: int
-    dt: float
 
 
 def spheroid_run(aspect: float, radius: float, strain: float, *, angle0: float = 0.5 * math.pi,
@@ -122,14 +118,12 @@ def spheroid_run(aspect: float, radius: float, strain: float, *, angle0: float =
     rows = []
     while True:
         axis = sim.bodies.rotations()[0][:, 0]
-        rows.append((sim.strain, math.atan2(axis[1], axis[0]), axis[2],
-                     spin_ratio(sim.bodies.angular_velocities(), RATE)))
+        rows.append((sim.strain, math.atan2(axis[1], axis[0]), axis[2]))
         if sim.strain >= strain:
             break
         sim.advance(stride)
     data = np.array(rows)
-    return SpheroidRun(data[:, 0], np.unwrap(data[:, 1]), data[:, 2], data[:, 3],
-                       sim.n_particles, sim.dt)
+    return SpheroidRun(data[:, 0], np.unwrap(data[:, 1]), data[:, 2], sim.n_particles)
 
 
 class OrbitFit(NamedTuple):

@@ -58,7 +58,7 @@ class HealthWatch:
     """The health extremes of a run, updated at each sample; stops the run (NumericalError
     with the simulation's reason) at the first sample outside its health limits. Also keeps
     each sample's strain, the bodies' spin ratio and, for grains, the nematic order of their
-    long axes (``body_spin``, ``body_order`` of ``Simulation.sample``; :meth:`steady_means`)."""
+    long axes (``Simulation.body_orientation``; :meth:`steady_means`)."""
 
     def __init__(self) -> None:
         self.density_error, self.smallest_gap, self.body_speed = 0.0, math.inf, 0.0
@@ -87,9 +87,9 @@ class HealthWatch:
         wall_speed = 0.5 * scene.flow.shear_rate * scene.box[1]
         self.body_speed = max(self.body_speed,
                               float(np.sqrt((peculiar ** 2).sum(axis=1)).max()) / wall_speed)
-        scalars = sim.sample()
-        self.samples.append((sim.strain, scalars["body_spin"],
-                             scalars.get("body_order", math.nan)))
+        orientation = sim.body_orientation()
+        self.samples.append((sim.strain, orientation["body_spin"],
+                             orientation.get("body_order", math.nan)))
 
 
 def add_run_options(parser: argparse.ArgumentParser, *, units: float = 4.0,
