@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from suspsim.sph import JIT_OPTIONS
@@ -68,29 +69,48 @@ def place_body_particles(members, body_of, offsets, centres, rotations, velociti
         particle_velocities[i, 2] = velocities[b, 2] + w[0] * sy - w[1] * sx
 
 
-@njit(**JIT_OPTIONS)
+#: Fixed slices of the members that :func:`body_force_torque` sums in parallel and then adds
+#: in order, so that F, T and the virial do not depend on the thread count [choice].
+SLICES = 4
+
+
+@njit(parallel=True, **JIT_OPTIONS)
 def body_force_torque(members, body_of, offsets, rotations, force_acc, width, forces, torques,
                       virial):
     """F_b, T_b (B, 3) from the pair forces on each body's particles (``force_acc`` flat, stride
     ``width``, force first) and the stress correction ``virial`` (5,) (module docstring)."""
+    n_bodies = forces.shape[0]
+    partial = np.zeros((SLICES, n_bodies, 6))
+    partial_virial = np.zeros((SLICES, 5))
+    n = members.shape[0]
+    for c in prange(SLICES):
+        acc = partial[c]
+        vir = partial_virial[c]
+        for k in range(c * n // SLICES, (c + 1) * n // SLICES):
+            i = members[k]
+            b = body_of[i]
+            sx, sy, sz = _arm(rotations[b], offsets[i])
+            fx = force_acc[width * i]
+            fy = force_acc[width * i + 1]
+            fz = force_acc[width * i + 2]
+            acc[b, 0] += fx
+            acc[b, 1] += fy
+            acc[b, 2] += fz
+            acc[b, 3] += sy * fz - sz * fy
+            acc[b, 4] += sz * fx - sx * fz
+            acc[b, 5] += sx * fy - sy * fx
+            vir[VXX] -= fx * sx
+            vir[VYY] -= fy * sy
+            vir[VZZ] -= fz * sz
+            vir[VXY] -= fx * sy
+            vir[VYX] -= fy * sx
     forces[:] = 0.0
     torques[:] = 0.0
     virial[:] = 0.0
-    for k in range(members.shape[0]):
-        i = members[k]
-        b = body_of[i]
-        sx, sy, sz = _arm(rotations[b], offsets[i])
-        fx = force_acc[width * i]
-        fy = force_acc[width * i + 1]
-        fz = force_acc[width * i + 2]
-        forces[b, 0] += fx
-        forces[b, 1] += fy
-        forces[b, 2] += fz
-        torques[b, 0] += sy * fz - sz * fy
-        torques[b, 1] += sz * fx - sx * fz
-        torques[b, 2] += sx * fy - sy * fx
-        virial[VXX] -= fx * sx
-        virial[VYY] -= fy * sy
-        virial[VZZ] -= fz * sz
-        virial[VXY] -= fx * sy
-        virial[VYX] -= fy * sx
+    for c in range(SLICES):
+        for b in range(n_bodies):
+            for d in range(3):
+                forces[b, d] += partial[c, b, d]
+                torques[b, d] += partial[c, b, 3 + d]
+        for d in range(5):
+            virial[d] += partial_virial[c, d]

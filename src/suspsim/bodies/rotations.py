@@ -14,6 +14,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
+
+from suspsim.sph import JIT_OPTIONS
 
 __all__ = ["random_quaternions", "rotation_matrices"]
 
@@ -28,12 +31,26 @@ def random_quaternions(count: int, rng: np.random.Generator) -> np.ndarray:
     return np.where(q[:, :1] < 0.0, -q, q)
 
 
+@njit(**JIT_OPTIONS)
+def _rotation_matrices(q, out):
+    """R(q) of each row of ``q`` (count, 4) into ``out`` (count, 3, 3) (module docstring)."""
+    for b in range(q.shape[0]):
+        w, x, y, z = q[b, 0], q[b, 1], q[b, 2], q[b, 3]
+        out[b, 0, 0] = 1 - 2 * (y * y + z * z)
+        out[b, 0, 1] = 2 * (x * y - w * z)
+        out[b, 0, 2] = 2 * (x * z + w * y)
+        out[b, 1, 0] = 2 * (x * y + w * z)
+        out[b, 1, 1] = 1 - 2 * (x * x + z * z)
+        out[b, 1, 2] = 2 * (y * z - w * x)
+        out[b, 2, 0] = 2 * (x * z - w * y)
+        out[b, 2, 1] = 2 * (y * z + w * x)
+        out[b, 2, 2] = 1 - 2 * (x * x + y * y)
+
+
 def rotation_matrices(quaternions: np.ndarray) -> np.ndarray:
-    """Rotation matrices (count, 3, 3) of unit quaternions (count, 4)."""
-    q = np.asarray(quaternions, dtype=np.float64)
-    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1),
-    ], axis=1)
+    """Rotation matrices (count, 3, 3) of unit quaternions (count, 4). Compiled: a run builds
+    them every step, and the stacked NumPy form took 75 µs for 49 bodies."""
+    q = np.ascontiguousarray(quaternions, dtype=np.float64).reshape(-1, 4)
+    out = np.empty((q.shape[0], 3, 3))
+    _rotation_matrices(q, out)
+    return out

@@ -149,7 +149,8 @@ def accelerations(positions, predicted, box, offset, nl_start, nl_image_start, n
 
 @njit(**JIT_OPTIONS)
 def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, reference,
-                  positions, velocities, accel, predicted, accel_new, box, nl_start,
+                  nl_cells, nl_cell_start, positions, velocities, accel, predicted, accel_new,
+                  box, nl_start,
                   nl_image_start, nl_neighbours, kernel, h, mass, rho_eq, c2, shear_rate,
                   body_force, dimension, law_code, law_params, newtonian, velocity_gradient,
                   smooth_rate, normalise, normalisation_interval, normalisation_age, alpha, beta,
@@ -171,8 +172,9 @@ def advance_steps(n_steps, resume, step_count, dt, build_time, cutoff, skin, ref
         if not resume:
             drift(positions, velocities, accel, dt)
             if list_outdated(positions, reference, shear_rate * (time - build_time), cutoff,
-                             skin, 0.5 * box[1], box, offset, nl_start, nl_neighbours,
-                             body_of, np.int64(MAX_CHECKED_OUTLIERS)):
+                             skin, 0.5 * box[1], box, offset, nl_cells, nl_cell_start,
+                             nl_start, nl_neighbours, body_of,
+                             np.int64(MAX_CHECKED_OUTLIERS)):
                 return done, REBUILD
         resume = False
         predict(velocities, accel, dt, predicted)

@@ -42,7 +42,8 @@ from suspsim.rheology.laws import make_law
 from suspsim.scene import Scene
 from suspsim.sph import kernels
 from suspsim.sph.boundaries import lees_edwards_offset
-from suspsim.sph.density import TABLE_OK, allocate_pair_table, pair_capacity
+from suspsim.sph.density import (TABLE_OK, allocate_pair_table, fluid_mean_density,
+                                 pair_capacity)
 from suspsim.sph.health import density_verdict
 from suspsim.sph.integrator import (GROW_TABLE, REBUILD, accelerations, advance_steps, drift,
                                     kick, predict)
@@ -386,8 +387,8 @@ class Simulation:
             box, *physics = self._physics_args()
             done, stop = advance_steps(
                 remaining, resume, self.step_count, self.dt, self._build_time, nl.cutoff,
-                nl.skin, self._reference, self._x, self._v, self._a, self._v_pred, self._a_new,
-                box, *physics)
+                nl.skin, self._reference, nl.cells, nl.cell_start, self._x, self._v, self._a,
+                self._v_pred, self._a_new, box, *physics)
             self.step_count += int(done)
             remaining -= int(done)
             resume = stop in (REBUILD, GROW_TABLE)
@@ -487,8 +488,8 @@ class Simulation:
             nl = self._nlist
             if list_outdated(self._x, self._reference, self._rate * (time - self._build_time),
                              nl.cutoff, nl.skin, 0.5 * self._box[1], self._box,
-                             self._offset(time), nl.start, nl.neighbours, self._body_of,
-                             MAX_CHECKED_OUTLIERS):
+                             self._offset(time), nl.cells, nl.cell_start, nl.start,
+                             nl.neighbours, self._body_of, MAX_CHECKED_OUTLIERS):
                 self._rebuild(time)
                 # The rebuild wrapped and reordered x, v and a, not ṽ.
                 predict(self._v, self._a, dt, self._v_pred)
@@ -611,8 +612,7 @@ class Simulation:
 
     def _fluid_mean_density(self) -> float:
         """Mean summation density of the fluid particles [m h^-d] (body shells excluded)."""
-        n_fluid = self.n_particles - self._members.shape[0]
-        return float((np.sum(self._rho) - np.sum(self._rho[self._members])) / n_fluid)
+        return float(fluid_mean_density(self._rho, self._body_of))
 
     def _density_errors(self) -> np.ndarray:
         """|ρ/ρ_eq − 1| of each fluid particle [1] (a rigid body's particles cannot follow)."""

@@ -239,7 +239,8 @@ def outdated(moved, nlist, box, offset, strain=0.0, group=None,
              max_checked=lv.MAX_CHECKED_OUTLIERS):
     group = np.empty(0, dtype=np.int64) if group is None else group
     return lv.list_outdated(moved, nlist.reference, strain, nlist.cutoff, nlist.skin, 0.0, box,
-                            offset, nlist.start, nlist.neighbours, group, max_checked)
+                            offset, nlist.cells, nlist.cell_start, nlist.start,
+                            nlist.neighbours, group, max_checked)
 
 
 def test_outliers_checked_pair_by_pair():
@@ -286,6 +287,70 @@ def test_list_outdated_never_misses_a_pair(strain):
             kept_beyond_bound += lv.needs_rebuild(moved, nlist.reference, strain,
                                                   nlist.cutoff, SKIN)
     assert 5 <= kept_beyond_bound < 35
+
+
+def wide_scene(rng):
+    """A box of 5 × 6 × 5 cells of r_c = 1.3, so outliers are searched in the build's cells."""
+    box, positions = scene("random", (7.0, 8.3, 7.5), 3, rng, density=1.5)
+    offset = 2.3
+    nlist, _ = build(positions, box, 3, offset, skin=SKIN)
+    return box, offset, nlist
+
+
+def displaced(nlist, box, rng, strain, outliers, spread):
+    """The reference sheared by ``strain`` about y = 0, jiggled, ``outliers`` moved by
+    ``spread``; with the LE offset that strain gives and every |d̃| (module docstring)."""
+    moved = nlist.reference.copy()
+    moved[:, 0] += strain * nlist.reference[:, 1]
+    moved += rng.normal(0.0, 0.03, moved.shape)
+    chosen = rng.choice(len(moved), size=outliers, replace=False)
+    moved[chosen] += rng.normal(0.0, spread, (outliers, 3))
+    d = moved - nlist.reference
+    d[:, 0] -= strain * nlist.reference[:, 1]
+    return moved, np.sqrt((d ** 2).sum(axis=1))
+
+
+@pytest.mark.parametrize("strain", [0.0, 0.1, 0.2])
+def test_the_cell_search_finds_every_partner_of_a_moved_particle(strain):
+    """Partners within h now, searched in the build's cells within (h + |d̃_i| + |d̃|max)/σ_min
+    of i's reference position, are those of a search over every particle, for every particle
+    (some reaching two cell layers), across the Lees–Edwards faces."""
+    rng = np.random.default_rng(3)
+    box, offset, nlist = wide_scene(rng)
+    moved, d = displaced(nlist, box, rng, strain, outliers=12, spread=0.2)
+    new_offset = (offset + strain * box[1]) % box[0]
+    sigma = math.sqrt(1.0 + 0.25 * strain ** 2) - 0.5 * strain
+    h, group = nlist.cutoff - nlist.skin, np.empty(0, dtype=np.int64)
+    near, anywhere = [], []
+    reaches = (h + d + d.max()) / sigma + 1e-9 * box[0]
+    assert reaches.max() > (box / nlist.cells).min()
+    for i, reach in enumerate(reaches):
+        near.append(lv._missed_near(i, moved, nlist.reference, reach, box, new_offset, offset,
+                                    nlist.cells, nlist.cell_start, h, nlist.start,
+                                    nlist.neighbours, group))
+        anywhere.append(lv._missed_anywhere(i, moved, box, new_offset, h, nlist.start,
+                                            nlist.neighbours, group))
+    assert min(near) >= 0
+    assert near == anywhere
+    assert sum(anywhere) > 0
+
+
+def test_list_outdated_in_a_wide_box_never_misses_a_pair():
+    """list_outdated, searching the build's cells, keeps the list exactly when brute force
+    finds no pair within h missing from it, also where the bound alone would rebuild."""
+    rng, strain = np.random.default_rng(4), 0.05
+    box, offset, nlist = wide_scene(rng)
+    new_offset = (offset + strain * box[1]) % box[0]
+    kept_beyond_bound = 0
+    for trial in range(12):
+        moved, _ = displaced(nlist, box, rng, strain, outliers=int(rng.integers(1, 6)),
+                             spread=0.25)
+        keep = not outdated(moved, nlist, box, new_offset, strain)
+        assert keep == (not missed_pairs(moved, box, new_offset, nlist))
+        if keep:
+            kept_beyond_bound += lv.needs_rebuild(moved, nlist.reference, strain,
+                                                  nlist.cutoff, SKIN)
+    assert 2 <= kept_beyond_bound < 11
 
 
 def test_overflow_code_and_error():
