@@ -1,7 +1,7 @@
 """Sand grains against spheres at equal φ over several packings, in a Newtonian matrix.
 
     python docs/figures/make_shape_seeds.py [--phi 0.3] [--seeds 1 2 3] [--strain 1 4]
-        [--box 16.875] [--shapes sphere sand] [--set KEY=VALUE ...]
+        [--box 16.875] [--radius 2.5] [--shapes sphere sand] [--set KEY=VALUE ...]
 
 The sand and spheres studies compare one packing per φ, in different boxes (15 h and 16.875 h)
 and a thinning matrix. This isolates the shape: both shapes in the same 16.875 h box (the sand
@@ -16,7 +16,8 @@ surfaces [h] and the largest body speed relative to the flow over the wall speed
 samples; and, after the transient, the bodies' mean spin Ω_z/(−γ̇/2) and the nematic order S of
 the grains' long axes (``analysis.orientation``). A run that leaves its health limits stops at
 that sample with the reason, is reported and left out of the means. ``--box`` takes another side
-(a multiple of the lattice spacing 0.625 h, see ``scene_rules.lattice_mismatch``). One thread
+(a multiple of the lattice spacing 0.625 h, see ``scene_rules.lattice_mismatch``) and
+``--radius`` another a (a finer body; the box must hold 6.5 a for sand). One thread
 per run; prints a Markdown table and writes nothing else.
 """
 import argparse
@@ -38,6 +39,8 @@ def main() -> None:
     parser.add_argument("--phi", type=float, default=0.3)
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     parser.add_argument("--box", type=float, default=BOX, help=f"cube side [h] (default {BOX})")
+    parser.add_argument("--radius", type=float, default=RADIUS,
+                        help=f"volume-equivalent radius a [h] (default {RADIUS})")
     add_run_options(parser, example=", e.g. run.dt=0.1 or inclusions.lubrication.repulsion=1e5")
     parser.add_argument("--shapes", nargs="+", default=["sphere", "sand"],
                         choices=("sphere", "sand"))
@@ -46,7 +49,7 @@ def main() -> None:
     overrides = parse_overrides(args.set)
     means = {}
     settings = overrides_text(overrides)
-    print(f"φ = {args.phi}, box {args.box} h, a = {RADIUS} h, μ = 1, γ̇ = {RATE}, strain "
+    print(f"φ = {args.phi}, box {args.box} h, a = {args.radius} h, μ = 1, γ̇ = {RATE}, strain "
           f"{transient:g} + {units}{settings}\n| shape | seed | η_r | η_r^p | CPU [s] | "
           f"density error | smallest gap [h] | body speed / wall speed | spin | order S |\n"
           f"|---|---|---|---|---|---|---|---|---|---|",
@@ -56,7 +59,7 @@ def main() -> None:
         for seed in args.seeds:
             started = time.process_time()
             try:
-                r = relative_viscosity(shape=shape, phi=args.phi, radius=RADIUS, box=args.box,
+                r = relative_viscosity(shape=shape, phi=args.phi, radius=args.radius, box=args.box,
                                        seed=seed, transient=transient, units=units,
                                        overrides=overrides)
             except NumericalError as err:
