@@ -1,8 +1,10 @@
 """Rigid placement of body particles (with Lees–Edwards images), body force, torque and virial."""
+import numba
 import numpy as np
 
 from suspsim.bodies.coupling import body_force_torque, place_body_particles
 from suspsim.bodies.rotations import random_quaternions, rotation_matrices
+from suspsim.threads import use_threads
 
 BOX = np.array([10.0, 8.0, 6.0])
 
@@ -79,3 +81,22 @@ def test_force_torque_and_constraint_virial_against_direct_sums():
     outer = -np.einsum("na,nb->ab", f_body, arms)
     np.testing.assert_allclose(virial, [outer[0, 0], outer[1, 1], outer[2, 2], outer[0, 1],
                                         outer[1, 0]], atol=1e-12)
+
+
+def test_force_torque_sums_do_not_depend_on_the_thread_count():
+    """The members are summed in fixed slices, so one and two threads give the same bits."""
+    rng = np.random.default_rng(4)
+    centres, rot, offsets, body_of, members, _, _ = _bodies(rng, count=7, per_body=300)
+    width = 6
+    acc = rng.normal(size=len(members) * width)
+    results, before = [], numba.get_num_threads()
+    try:
+        for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            use_threads(threads)
+            out = np.zeros((7, 3)), np.zeros((7, 3)), np.zeros(5)
+            body_force_torque(members, body_of, offsets, rot, acc, width, *out)
+            results.append(out)
+    finally:
+        numba.set_num_threads(before)
+    for one, two in zip(*results):
+        np.testing.assert_array_equal(one, two)
