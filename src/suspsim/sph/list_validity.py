@@ -82,9 +82,13 @@ def needs_rebuild(positions, reference, strain, cutoff, skin, y_origin=0.0):
 #: particles, two threads; a build 4.4 ms): after a build the bound holds for 8 steps, then
 #: the outliers grow from 1 to 17, 146, 494, 1,117 and 5,000 over steps 9, 12, 15, 17, 19 and
 #: 25, where the list first misses a pair; checking them costs about 0.5 µs each (the build's
-#: cells around each), so the list lives 10 steps with at most 16 checked, 16 with 512 and 18
-#: with 1,024, and build plus checks average 0.45, 0.31 and 0.33 ms a step.
-MAX_CHECKED_OUTLIERS = 512
+#: cells around each), so the list lives 10 steps with at most 16 checked, 14 with 128, 16 with
+#: 512 and 18 with 1,024, and build plus checks average 0.45, 0.33, 0.31 and 0.33 ms a step.
+#: Not 512: with 256 and 512 the reduced two-sphere sliding test (tests/validation/
+#: test_squeeze.py) read 0.88 and 0.73 of theory at gaps of 0.12–0.2 h, with 0–128 and 2,048
+#: 0.97–1.07 (eight runs), though every kept list was complete (898 steps checked against
+#: every pair); the gap holds about one particle, whose path the rebuild times change.
+MAX_CHECKED_OUTLIERS = 128
 #: Most distances the fallback of boxes too small for the cell search (fewer cells across than
 #: an outlier's reach spans) may compute before a rebuild is cheaper [choice]: about the
 #: candidate distances of a build of the benchmark box.
