@@ -86,7 +86,7 @@ def needs_rebuild(positions, reference, strain, cutoff, skin, y_origin=0.0):
 #: 512 and 18 with 1,024, and build plus checks average 0.45, 0.33, 0.31 and 0.33 ms a step.
 #: Not 512: with 256 and 512 the reduced two-sphere sliding test (tests/validation/
 #: test_squeeze.py) read 0.88 and 0.73 of theory at gaps of 0.12–0.2 h, with 0–128 and 2,048
-#: 0.97–1.07 (eight runs), though every kept list was complete (898 steps checked against
+#: 0.96–1.07 (seven runs), though every kept list was complete (898 steps checked against
 #: every pair); the gap holds about one particle, whose path the rebuild times change.
 MAX_CHECKED_OUTLIERS = 128
 #: Most distances the fallback of boxes too small for the cell search (fewer cells across than
