@@ -118,21 +118,27 @@ def _cell_span(centre, reach, length, n):
     return first, (count if count <= n else 0)
 
 
+@njit(inline="always", cache=True)
+def _missed(i, j, g, positions, box, offset, h2, start, neighbours, group):
+    """Whether particle j, not i and not of i's group g (−1: none), is now within h of i (LE
+    minimum image at ``offset``; ``h2`` = h²) without its pair in the half list."""
+    if j == i or (g >= 0 and group[j] == g):
+        return False
+    dx, dy, dz, _ = minimum_image_3d(positions[i, 0] - positions[j, 0],
+                                     positions[i, 1] - positions[j, 1],
+                                     positions[i, 2] - positions[j, 2],
+                                     box[0], box[1], box[2], offset)
+    return (dx * dx + dy * dy + dz * dz < h2
+            and not _is_listed(i, np.int64(j), start, neighbours))
+
+
 @njit(cache=True)
 def _missed_anywhere(i, positions, box, offset, h, start, neighbours, group):
     """:func:`_missed_near` over every particle: for boxes too small for its cells."""
     g = group[i] if group.shape[0] > 0 else -1
     missed = 0
     for j in range(positions.shape[0]):
-        if j == i or (g >= 0 and group[j] == g):
-            continue
-        dx, dy, dz, _ = minimum_image_3d(positions[i, 0] - positions[j, 0],
-                                         positions[i, 1] - positions[j, 1],
-                                         positions[i, 2] - positions[j, 2],
-                                         box[0], box[1], box[2], offset)
-        if (dx * dx + dy * dy + dz * dz < h * h
-                and not _is_listed(i, np.int64(j), start, neighbours)):
-            missed += 1
+        missed += _missed(i, j, g, positions, box, offset, h * h, start, neighbours, group)
     return missed
 
 
@@ -166,15 +172,8 @@ def _missed_near(i, positions, reference, reach, box, offset, build_offset, cell
             for rz in range(z_first, z_first + z_count):
                 c = (wx * ny + wy) * nz + rz % nz
                 for j in range(cell_start[c], cell_start[c + 1]):
-                    if j == i or (g >= 0 and group[j] == g):
-                        continue
-                    dx, dy, dz, _ = minimum_image_3d(positions[i, 0] - positions[j, 0],
-                                                     positions[i, 1] - positions[j, 1],
-                                                     positions[i, 2] - positions[j, 2],
-                                                     lx, ly, lz, offset)
-                    if (dx * dx + dy * dy + dz * dz < h2
-                            and not _is_listed(i, np.int64(j), start, neighbours)):
-                        missed += 1
+                    missed += _missed(i, j, g, positions, box, offset, h2, start, neighbours,
+                                      group)
     return missed
 
 
