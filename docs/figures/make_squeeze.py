@@ -1,7 +1,7 @@
 """Make docs/figures/squeeze_force.{nc,png}: resolved SPH squeeze force between two spheres.
 
     python docs/figures/make_squeeze.py [--threads N] [--reduced] [--no-large]
-        [--set numerics.KEY=VALUE ...] [--slide K]
+        [--set numerics.KEY=VALUE ...] [--slide K] [--phases P]
     python docs/figures/make_squeeze.py --plot-only    # redraw from the .nc
 
 Runs :func:`suspsim.validation.squeeze.squeeze_study` for a = 2.5 h (box 25 × 20 × 20 h,
@@ -16,7 +16,9 @@ numerics keys of the runs' scenes (VALUE as JSON, e.g. ``numerics.shifting=100``
 print their tables and write no file. ``--slide K``: the spheres also slide past each other at
 ±K U while they approach (``squeeze_run``'s ``slide_ratio``; K = 1 is a pair at 45° in the
 compressional quadrant of a shear), at Re = 0.05 only; the table adds the sliding force over
-Jeffrey–Onishi's Y^A, and nothing is written.
+Jeffrey–Onishi's Y^A, and nothing is written. ``--phases P``: every approach runs at P
+shifts of the pair against the fluid's start lattice (``squeeze.lattice_shifts``), the ratios
+are the means over them, and the table adds each ratio's range over the phases.
 """
 import argparse
 import json
@@ -26,7 +28,7 @@ import xarray as xr
 
 from suspsim.io.atomic import atomic_path, save_figure
 from suspsim.plotting.squeeze import plot_squeeze
-from suspsim.validation.squeeze import squeeze_study, stokes_drag
+from suspsim.validation.squeeze import lattice_shifts, squeeze_study, stokes_drag
 
 OUTPUT = Path(__file__).resolve().with_name("squeeze_force.png")
 NETCDF = OUTPUT.with_suffix(".nc")
@@ -34,20 +36,35 @@ NETCDF = OUTPUT.with_suffix(".nc")
 
 def _table(data, title):
     a = data.attrs
-    print(f"\n{title}: a = {a['radius']:g} h, box {list(a['box'])} h, U = {a['speed']:.4g}, "
+    print(f"\n{title}: a = {a['radius']:g} h, box {[float(b) for b in a['box']]} h, "
+          f"U = {a['speed']:.4g}, "
           f"Re = {a['particle_reynolds_number']:g}, a_h/a = {a['hydrodynamic_radius_ratio']:.3f}"
           f", {a['n_particles']} particles, wall {a['squeeze_wall_time_s']:.0f} s + "
           f"{a['drag_wall_time_s']:.0f} s; cutoff gap s_c = {a['cutoff_gap']:.3g} h")
     print(f"lubrication correction at the scene's cutoff {a['lubrication_cutoff_gap']:.3g} h")
     sliding = data["ratio_sliding"].values if "ratio_sliding" in data else None
+    phases = data.sizes.get("phase", 1)
+    if phases > 1:
+        shifts = [round(float(x), 4) for x in data["phase"].values]
+        print(f"means over {phases} lattice phases (shifts {shifts} h); [range over them]")
     print("   s [h]   F/(6pi mu a U)   F/F_th(a_h)   F/F_th(a)   +lub./F_th(a)   box/free"
           + ("   sliding/F_th(a)" if sliding is not None else ""))
     for k, (s, n, r, rn, rc, c) in enumerate(zip(
             data["gap"].values, data["normalised_force"].values, data["ratio"].values,
             data["ratio_nominal"].values, data["ratio_combined"].values,
             data["image_correction"].values)):
-        print(f"  {s:6.3f}   {n:12.4g}   {r:11.3f}   {rn:9.3f}   {rc:13.3f}   {c:8.3f}"
-              + (f"   {sliding[k]:15.3f}" if sliding is not None else ""))
+        line = f"  {s:6.3f}   {n:12.4g}   {r:11.3f}   {rn:9.3f}   {rc:13.3f}   {c:8.3f}"
+        if phases > 1:
+            line += _range(data["phase_ratio_nominal"].values[:, k])
+        if sliding is not None:
+            line += f"   {sliding[k]:15.3f}"
+            if phases > 1:
+                line += _range(data["phase_ratio_sliding"].values[:, k])
+        print(line)
+
+
+def _range(values) -> str:
+    return f" [{min(values):.2f}, {max(values):.2f}]"
 
 
 def _save(runs, labels) -> None:
@@ -74,6 +91,8 @@ def main() -> None:
                         help="a numerics key of every run (repeatable; nothing is written)")
     parser.add_argument("--slide", type=float, default=0.0, metavar="K",
                         help="slide at +-K U while approaching (nothing is written)")
+    parser.add_argument("--phases", type=int, default=1, metavar="P",
+                        help="run each approach at P shifts against the start lattice")
     args = parser.parse_args()
     numerics = {}
     for item in args.set:
@@ -81,7 +100,8 @@ def main() -> None:
         if not key.startswith("numerics.") or not value:
             parser.error(f"--set {item}: give numerics.KEY=VALUE")
         numerics[key.removeprefix("numerics.")] = json.loads(value)
-    common = {"threads": args.threads, "numerics": numerics or None}
+    common = {"threads": args.threads, "numerics": numerics or None,
+              "shifts": lattice_shifts(args.phases)}
     slide = {"slide_ratio": args.slide} if args.slide > 0 else {}
     runs, labels = [], []
     if args.plot_only:
@@ -95,7 +115,8 @@ def main() -> None:
         labels.append("a = 2.5 h, reduced")
     else:
         box = (25.0, 20.0, 20.0)
-        drag = stokes_drag(2.5, box, reynolds=0.05, **common)
+        drag = stokes_drag(2.5, box, reynolds=0.05, threads=args.threads,
+                           numerics=numerics or None)
         for reynolds in (0.05,) if args.slide > 0 else (0.05, 0.025):
             runs.append(squeeze_study(2.5, box, reynolds=reynolds, drag=drag, **common,
                                       **slide))
