@@ -330,7 +330,7 @@ def pooled_runs(shifts, **kwargs) -> dict:
 
     Why: at gaps below about half a lattice spacing the resolved force of one run depends on
     where the spheres meet the fluid's start lattice, most of all the sliding force (reduced
-    size, six shifts of a sixth of a spacing: 0.32–1.12 of Jeffrey–Onishi at 0.12 h, mean 0.69;
+    size, six shifts 0.1 h apart: 0.32–1.12 of Jeffrey–Onishi at 0.12 h, mean 0.69;
     the squeeze 0.45–0.50). A suspension's fluid is disordered, so the calibration takes the
     mean over phases. Every run covers the same gaps in the same steps, so each phase weighs
     alike in a gap bin. Scalars are the first run's, with the wall times added and the health
