@@ -1,12 +1,13 @@
 """Make docs/figures/squeeze_force.{nc,png}: resolved SPH squeeze force between two spheres.
 
     python docs/figures/make_squeeze.py [--threads N] [--reduced] [--no-large]
-        [--set numerics.KEY=VALUE ...] [--slide K] [--phases P]
+        [--no-half-speed] [--set numerics.KEY=VALUE ...] [--slide K] [--phases P]
     python docs/figures/make_squeeze.py --plot-only    # redraw from the .nc
 
 Runs :func:`suspsim.validation.squeeze.squeeze_study` for a = 2.5 h (box 25 × 20 × 20 h,
-Re = 0.05, and the same at half the speed for the quasi-steady check) and a = 4 h (box
-32 × 25 × 25 h, Re = 0.1; skipped with --no-large), draws them with
+Re = 0.05, and the same at half the speed for the quasi-steady check, skipped with
+--no-half-speed, which writes nothing) and a = 4 h (box 32 × 25 × 25 h, Re = 0.1; skipped
+with --no-large), draws them with
 :func:`suspsim.plotting.squeeze.plot_squeeze` and prints the table s, F/F_theory and the
 recommended cutoff gap, and the resolved force plus the lubrication correction at the cutoff
 the scene applies (auto: ``scene_rules.AUTO_CUTOFF_GAP_CORRECTED``). --reduced: the test's small
@@ -91,6 +92,8 @@ def main() -> None:
                         help="a numerics key of every run (repeatable; nothing is written)")
     parser.add_argument("--slide", type=float, default=0.0, metavar="K",
                         help="slide at +-K U while approaching (nothing is written)")
+    parser.add_argument("--no-half-speed", action="store_true",
+                        help="skip the quasi-steady check at Re = 0.025 (nothing is written)")
     parser.add_argument("--phases", type=int, default=1, metavar="P",
                         help="run each approach at P shifts against the start lattice")
     args = parser.parse_args()
@@ -117,7 +120,7 @@ def main() -> None:
         box = (25.0, 20.0, 20.0)
         drag = stokes_drag(2.5, box, reynolds=0.05, threads=args.threads,
                            numerics=numerics or None)
-        for reynolds in (0.05,) if args.slide > 0 else (0.05, 0.025):
+        for reynolds in (0.05,) if args.slide > 0 or args.no_half_speed else (0.05, 0.025):
             runs.append(squeeze_study(2.5, box, reynolds=reynolds, drag=drag, **common,
                                       **slide))
             labels.append(f"a = 2.5 h, Re = {reynolds:g}")
@@ -127,7 +130,7 @@ def main() -> None:
             labels.append("a = 4 h, Re = 0.1")
     for data, label in zip(runs, labels):
         _table(data, label)
-    if numerics or args.reduced or args.slide > 0:
+    if numerics or args.reduced or args.slide > 0 or args.no_half_speed:
         return
     if not args.plot_only:
         _save(runs, labels)

@@ -15,7 +15,8 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
     the Einstein coefficient calibrates (line; dashed: the drag's hydrodynamic radius a_h).
     Bottom: F_SPH/F_theory(a) with the ``threshold`` line and each run's recommended cutoff gap
     s_c marked; open squares: the same plus the lubrication correction the run's scene applies
-    (``ratio_combined``, where the dataset has it).
+    (``ratio_combined``, where the dataset has it); a shaded band: the range over the lattice
+    phases of a run over several (``phase_ratio_nominal``).
     ``labels``: legend entries (default: a, a_h/a, U).
     """
     if isinstance(datasets, xr.Dataset):
@@ -35,6 +36,10 @@ def plot_squeeze(datasets, *, labels=None, threshold: float = 0.9) -> Figure:
         top.plot(gap, data["theory_force_nominal"].values / scale, "-", color=colour, lw=1.2)
         top.plot(gap, data["theory_force"].values / scale, "--", color=colour, lw=0.8)
         bottom.plot(gap, data["ratio_nominal"].values, "o-", ms=3, color=colour, label=label)
+        if data.sizes.get("phase", 1) > 1:
+            phases = data["phase_ratio_nominal"].values
+            bottom.fill_between(gap, np.nanmin(phases, axis=0), np.nanmax(phases, axis=0),
+                                color=colour, alpha=0.2, lw=0)
         if "ratio_combined" in data:
             bottom.plot(gap, data["ratio_combined"].values, "s--", ms=3, mfc="none",
                         color=colour, lw=0.8)
