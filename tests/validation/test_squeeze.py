@@ -12,11 +12,12 @@ import pytest
 
 from suspsim.validation.jeffrey_onishi import (squeeze_resistance, xa_coefficients, xa_functions,
                                                ya_coefficients, ya_functions)
-from suspsim.validation.squeeze import (bin_series, cutoff_gap, gap_edges, hasimoto_factor,
-                                        image_mobility, lattice_shifts, lubrication_correction,
-                                        periodic_oseen, periodic_oseen_xx,
-                                        periodic_self_coefficient, phase_means, pooled_runs,
-                                        reduced, sliding_theory, squeeze_study, squeeze_theory)
+from suspsim.validation.periodic_pair import (hasimoto_factor, image_mobility, periodic_oseen,
+                                              periodic_oseen_xx, periodic_self_coefficient,
+                                              sliding_theory, squeeze_theory)
+from suspsim.validation.squeeze import (bin_series, cutoff_gap, gap_edges, lattice_shifts,
+                                        lubrication_correction, phase_means, pooled_runs,
+                                        reduced, squeeze_study)
 
 
 def test_jeffrey_onishi_coefficients_match_the_tabulated_ones():
@@ -240,7 +241,7 @@ def test_resolved_sliding_force_meets_theory_beyond_half_a_lattice_spacing():
     # The line of centres turns by about 0.9 rad as the spheres pass.
     assert 0.5 < angle[0] < 1.2
     ratio = sliding / sliding_theory(gap, 2.5, 1.0, run["speed"], box, angle=angle)
-    half_spacing = 0.5 * 4.096 ** (-1.0 / 3.0)  # the runs' number density 4.096 h⁻³
+    half_spacing = lattice_shifts(2)[1]
     np.testing.assert_array_less(0.9, ratio[gap >= half_spacing])
     np.testing.assert_array_less(0.5, ratio[gap >= 0.05])
     middle = (gap >= 1.0) & (gap <= 2.5)
