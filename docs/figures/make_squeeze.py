@@ -97,6 +97,8 @@ def main() -> None:
     parser.add_argument("--phases", type=int, default=1, metavar="P",
                         help="run each approach at P shifts against the start lattice")
     args = parser.parse_args()
+    if args.phases < 1:
+        parser.error(f"--phases {args.phases}: give at least 1")
     numerics = {}
     for item in args.set:
         key, _, value = item.partition("=")
