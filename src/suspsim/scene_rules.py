@@ -126,25 +126,26 @@ AUTO_SHIFTING_NON_NEWTONIAN = 3.0
 
 #: Lubrication cutoff s_c [h] of inclusions.lubrication.cutoff_gap auto with
 #: numerics.spin_correction, by shifting coefficient A [choice]: the largest gap at which the
-#: resolved two-sphere squeeze force falls below 0.9 of Jeffrey–Onishi
-#: (``validation.squeeze.cutoff_gap``; a = 2.5 h, Re = 0.05, docs/figures/make_squeeze.py
-#: --no-large --set numerics.shifting=A), the larger of two motions: a pure approach (0.58, 0.185
-#: and 0.14 h) and an approach while sliding at the same speed (``--slide 1``, a pair at 45° in a
-#: shear's compressional quadrant: 0.58, 0.328 and 0.328 h). A sheared pair both approaches and
-#: slides, and the correction must cover every gap where either motion's resolved force falls
-#: short. Other A interpolate in log A and hold the end values beyond. Each value comes from one
-#: lattice phase. The means over four phases (``--phases 4``; docs/suspensions.md, "Lattice
-#: phases") give 0.44, 0.185 and 0.185 h, the sliding force included: the table is to move there
-#: once the suspension results are re-validated with it.
-AUTO_CUTOFF_GAP_CORRECTED = ((3.0, 0.58), (30.0, 0.328), (100.0, 0.328))
-#: The same with shifting tangential at the bodies (numerics.shifting_at_bodies; make_squeeze.py
-#: --no-large [--slide 1] --set numerics.shifting=A
-#: --set numerics.shifting_at_bodies='"tangential"'): approach 0.437, 0.246 and 0.185 h, while
-#: sliding —, 0.328 and 0.185 h (at A = 3 the squeeze while sliding reads 0.85–0.95 of the
-#: nominal theory from 0.44 h out to 2.5 h, a_h/a = 0.96, so it sets no cutoff).
+#: resolved two-sphere force falls below 0.9 of Jeffrey–Onishi (``validation.squeeze.cutoff_gap``
+#: on the mean over four lattice phases; a = 2.5 h, Re = 0.05, docs/figures/make_squeeze.py
+#: --no-large --phases 4 [--slide 1] --set numerics.shifting=A), the largest of three readings:
+#: the squeeze in a pure approach (0.438, 0.185 and 0.138 h at A = 3, 30 and 100), the squeeze
+#: while sliding at the same speed (``--slide 1``, a pair at 45° in a shear's compressional
+#: quadrant: 0.437, 0.104 and 0.185 h) and the sliding force beside it (never short, 0.185 h,
+#: never short). A sheared pair both approaches and slides, and the correction must cover every
+#: gap where a motion's resolved force falls short. Other A interpolate in log A and hold the
+#: end values beyond. One phase alone misleads: at A = 30 a single phase's sliding force reads
+#: 0.11–1.44 × theory below 0.25 h (docs/suspensions.md, "Lattice phases").
+AUTO_CUTOFF_GAP_CORRECTED = ((3.0, 0.44), (30.0, 0.185), (100.0, 0.185))
+#: The same with shifting tangential at the bodies, each reading still from one lattice phase
+#: (numerics.shifting_at_bodies; make_squeeze.py --no-large [--slide 1] --set
+#: numerics.shifting=A --set numerics.shifting_at_bodies='"tangential"'): approach 0.437, 0.246
+#: and 0.185 h, while sliding —, 0.328 and 0.185 h (at A = 3 the squeeze while sliding reads
+#: 0.85–0.95 of the nominal theory from 0.44 h out to 2.5 h, a_h/a = 0.96, so it sets no
+#: cutoff).
 AUTO_CUTOFF_GAP_TANGENTIAL = ((3.0, 0.437), (30.0, 0.328), (100.0, 0.185))
-#: The same without the spin correction (A = 30): approach 0.6 h, while sliding 0.778 h (the
-#: squeeze reads 0.89 there and at 0.58 h, 0.94–1.02 at 1–1.8 h).
+#: The same without the spin correction (A = 30, one phase): approach 0.6 h, while sliding
+#: 0.778 h (the squeeze reads 0.89 there and at 0.58 h, 0.94–1.02 at 1–1.8 h).
 AUTO_CUTOFF_GAP_UNCORRECTED = 0.778
 
 

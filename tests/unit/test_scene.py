@@ -242,9 +242,9 @@ def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected)
 
 
 @pytest.mark.parametrize("extra, spin, cutoff", [
-    ("", True, 0.58), ("numerics: {shifting: 30}\n", True, 0.328),
-    ("numerics: {shifting: 100}\n", True, 0.328), ("numerics: {shifting: 300}\n", True, 0.328),
-    ("numerics: {shifting: 10}\n", True, 0.4305),
+    ("", True, 0.44), ("numerics: {shifting: 30}\n", True, 0.185),
+    ("numerics: {shifting: 100}\n", True, 0.185), ("numerics: {shifting: 300}\n", True, 0.185),
+    ("numerics: {shifting: 10}\n", True, 0.2797),
     ("numerics: {shifting: 100, shifting_at_bodies: tangential}\n", True, 0.185),
     ("numerics: {shifting_at_bodies: tangential}\n", True, 0.437),
     ("numerics: {shifting: 10, shifting_at_bodies: tangential}\n", True, 0.3760),
@@ -267,9 +267,9 @@ def test_spin_correction_and_cutoff_auto_follow_the_squeeze_calibration(tmp_path
 
 
 def test_an_auto_cutoff_below_min_gap_is_refused(tmp_path):
-    with pytest.raises(InputError, match="min_gap 0.4 must be below cutoff_gap 0.328"):
+    with pytest.raises(InputError, match="min_gap 0.2 must be below cutoff_gap 0.185"):
         load_scene(_write(tmp_path, MINIMAL + "numerics: {shifting: 30}\ninclusions: {phi: 0.1, "
-                          "radius: 2.0, lubrication: {min_gap: 0.4}}\n"))
+                          "radius: 2.0, lubrication: {min_gap: 0.2}}\n"))
 
 
 def test_density_limits_let_outliers_pass_only_with_inclusions(tmp_path):

@@ -170,12 +170,13 @@ def test_resolved_squeeze_force_follows_theory_down_to_the_cutoff():
     at 1–2.5 h F_SPH/F_theory 0.96–1.07 with a_h and 1.21–1.28 with the nominal a; below 0.9 ×
     F_theory(a) from 0.25 h (0.185 h at Re = 0.025, 0.18 h at a = 4 h); with the lubrication
     correction of the cutoff 0.185 h the total read 0.76–1.28 × F_theory(a) from 0.06 h to
-    2.5 h. The scene's auto cutoff is now 0.328 h, where the squeeze falls short once the
-    spheres also slide (the next test), so here a pure approach must fall short inside three
-    quarters of it. Reduced size (box 20 × 15 × 15 h, Re = 0.1): a_h/a = 1.067; at
-    1–2.5 h 0.81–0.90 with a_h and 1.02–1.12 with a; below 0.9 from 0.47 h; the total
-    0.66–1.12. So the resolved force lies between the theories of the two radii, and the
-    check takes that band with a 15 % margin; the total's band [0.6, 1.4] is a guard (the
+    2.5 h. The scene's auto cutoff is 0.185 h, where the mean over four lattice phases of this
+    approach falls short (the phases differ little here; the sliding test says why the mean),
+    so here one phase must fall short inside three quarters of it, and at full size its own
+    cutoff (0.25 h) lie within 1.5 × of it. Reduced size (box 20 × 15 × 15 h, Re = 0.1):
+    a_h/a = 1.067; at 1–2.5 h 0.81–0.90 with a_h and 1.02–1.12 with a; below 0.9 from 0.47 h;
+    the total 0.66–1.12. So the resolved force lies between the theories of the two radii, and
+    the check takes that band with a 15 % margin; the total's band [0.6, 1.4] is a guard (the
     resolved force alone reads 0.3 at 0.06 h), not a tight criterion. Without shifting the
     fluid the spheres push through turns disordered and the single-sphere drag read
     2.3 × Stokes."""
@@ -224,7 +225,7 @@ def test_resolved_sliding_force_meets_theory_beyond_half_a_lattice_spacing():
     1–2.5 h; within half a spacing at least half of theory (a guard: below it the SPH fluid
     under-resolves the tangential mode, which the lubrication correction does not make up);
     and the scene's cutoff covers every gap at which the phase mean of the squeeze force falls
-    below 0.9 × theory."""
+    below 0.9 × theory (at full size, where it is calibrated; within 1.5 × at reduced size)."""
     if reduced():
         box, reynolds, end_gap, phases = (20.0, 15.0, 15.0), 0.1, 0.1, 3
     else:
@@ -248,4 +249,7 @@ def test_resolved_sliding_force_meets_theory_beyond_half_a_lattice_spacing():
     assert middle.sum() >= 3
     np.testing.assert_array_less(ratio[middle], 1.5)
     squeeze_ratio = squeeze / squeeze_theory(gap, 2.5, 1.0, run["speed"], box, angle=angle)
-    assert cutoff_gap(gap, squeeze_ratio) <= run["lubrication_cutoff_gap"]
+    # The cutoff is calibrated at full size; the reduced box at twice the Reynolds number falls
+    # short to about one bin (a factor 1.33) further out, the band the approach test allows.
+    cover = 1.0 if not reduced() else 1.5
+    assert cutoff_gap(gap, squeeze_ratio) <= cover * run["lubrication_cutoff_gap"]

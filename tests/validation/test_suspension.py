@@ -218,9 +218,9 @@ def test_torque_free_sphere_turns_with_the_fluid():
 
 
 @pytest.mark.xfail(strict=True, reason="frictionless dense spheres read below the fits "
-                   "(5.61-8.78 at phi = 0.4): with the spin correction and its cutoff 0.328 h "
-                   "4.51, 4.59 (16.875 h box, seeds 1/2, strain 1 + 4; 0.185 h: 3.85, 4.31 in "
-                   "this 15 h box, strain 1 + 8; README); contact friction puts them inside "
+                   "(5.61-8.78 at phi = 0.4): with the spin correction and its cutoff 0.185 h "
+                   "4.45, 4.47 (16.875 h box, seeds 1/2, strain 1 + 4; 3.85, 4.31 in this "
+                   "15 h box, strain 1 + 8; README); contact friction puts them inside "
                    "(the frictional test below; issue 4)")
 @pytest.mark.xdist_group("dense")
 def test_dense_suspension_inside_published_envelope():
@@ -254,16 +254,16 @@ PHI_03_BELOW = pytest.mark.xfail(strict=True, reason=(
     pytest.param(0.3, (1, 2, 3, 4), marks=[FULL_SIZE, PHI_03_BELOW])])
 def test_spheres_inside_published_envelope(phi, seeds):
     """Frictionless Newtonian spheres a = 2.5 h with the defaults (spin correction and its
-    squeeze cutoff 0.328 h) in a 15 h box (strain 1 + 4): the mean η_r of the packing ``seeds``
+    squeeze cutoff 0.185 h) in a 15 h box (strain 1 + 4): the mean η_r of the packing ``seeds``
     inside the min–max of the experimental fits (REFERENCE_NUMBERS §2a), where the uncorrected
     form reads 5–25 % below it. φ = 0.3 reads below (the mark); its packings scatter by ±9 %,
     so it takes four.
 
-    Measured (2026-12-07, one thread, ``make_shape_seeds.py --box 15``): φ = 0.1: 1.334 ±
-    0.009, 1.307 ± 0.006 (mean 1.320) against 1.316–1.435 (Batchelor & Green 1.302); φ = 0.2:
-    1.951 ± 0.045, 1.894 ± 0.020 against 1.851–2.232 (with the cutoff 0.185 h: 1.335, 1.303;
-    1.930, 1.876). With μ_c = 0.5 as well (0.185 h): 1.337, 1.306; 2.044, 2.015; 3.56, 3.20 at
-    φ = 0.3."""
+    Measured (2026-12-07, evening, this test): φ = 0.1: 1.334 ± 0.008, 1.305 ± 0.008 (mean
+    1.320) against 1.316–1.435 (Batchelor & Green 1.302); φ = 0.2: 1.937 ± 0.030, 1.862 ±
+    0.026 (mean 1.900) against 1.851–2.232. With the one-phase cutoff 0.328 h: 1.334, 1.307;
+    1.951, 1.894. With μ_c = 0.5 as well (0.185 h, 2026-12-06): 1.337, 1.306; 2.044, 2.015;
+    3.56, 3.20 at φ = 0.3."""
     _envelope_check(phi, 15.0, seeds)
 
 
@@ -279,8 +279,10 @@ def test_frictional_dense_spheres_inside_published_envelope(phi):
 
     Measured (2026-12-06, with the spin correction and its cutoff): φ = 0.4: 6.92 ± 0.87,
     7.61 ± 0.36 against 5.61–8.78; φ = 0.5: 35.6 ± 2.0, 38.7 ± 4.5 against 17.7–42.8. Without
-    the correction: 5.77 ± 0.57, 8.16 ± 0.71 and 28.3 ± 1.5, 45.7 ± 4.9. With the cutoff 0.328 h
-    (2026-12-07, ``make_shape_seeds.py``): 7.65 ± 1.13, 7.73 ± 0.57 and 33.9 ± 5.3, 32.4 ± 3.5."""
+    the correction: 5.77 ± 0.57, 8.16 ± 0.71 and 28.3 ± 1.5, 45.7 ± 4.9. With the one-phase
+    cutoff 0.328 h (2026-12-07, ``make_shape_seeds.py``): 7.65 ± 1.13, 7.73 ± 0.57 and 33.9 ±
+    5.3, 32.4 ± 3.5; with 0.185 h (2026-12-07, evening, this test): 6.96 ± 0.89, 7.49 ± 0.49
+    and 33.3 ± 1.8, 34.1 ± 3.7."""
     _envelope_check(phi, 16.875, (1, 2), {"inclusions.lubrication.friction": 0.5})
 
 
@@ -295,12 +297,15 @@ def test_power_law_matrix_follows_homogenisation(phi, seeds):
     Rigid spheres in a thinning matrix thicken it less than in a Newtonian one, but never below
     the matrix (η_r ≥ 1). At φ = 0.3 one packing's ratio moves by more than 5 % between packings
     (−2.7 % and +5.3 % for seeds 1 and 2, below), so that check takes two. g is measured with
-    the non-Newtonian matrix's numerics (shifting A = 3, hence the lubrication cutoff 0.58 h
+    the non-Newtonian matrix's numerics (shifting A = 3, hence the lubrication cutoff 0.44 h
     with the spin correction): a Newtonian matrix alone would take A = 30 and its cutoff
     0.185 h, which read g(0.1) = 1.339 against 1.417 at A = 3, and the estimate must compare
     one numerical model in two matrices.
 
-    Measured (strain 2–10, 2026-12-06 evening, the defaults with the spin correction): φ = 0.1:
+    Measured (2026-12-07, evening, this test, the cutoff 0.44 h): φ = 0.1: g = 1.416, η_r =
+    1.263 against 1.265 (−0.2 %); φ = 0.3, seed 1: g = 3.133, η_r = 2.105 against 2.154
+    (−2.3 %); seed 2: g = 3.040, η_r = 2.179 against 2.106 (+3.5 %); mean +0.6 %. With the
+    one-phase cutoff 0.58 h (strain 2–10, 2026-12-06 evening): φ = 0.1:
     g = 1.417, η_r = 1.262 against 1.265 (−0.2 %); φ = 0.3, seed 1: g = 3.203, η_r = 2.130
     against 2.190 (−2.7 %); seed 2: g = 3.068, η_r = 2.233 against 2.120 (+5.3 %); mean
     +1.3 %. With μ_c = 0.5 as well: 0.0 %, +1.7 %, +7.1 %. Without the correction (2026-12-06,
@@ -340,9 +345,11 @@ def test_bingham_matrix_follows_homogenisation(x):
     below g (seed 000: "only about a factor of two to three higher" than the matrix).
 
     g is measured with the non-Newtonian matrix's numerics (the power-law test says why).
-    Measured (2026-12-06 evening, the defaults with the spin correction, this test's packing,
-    strain 2–10): g = 4.856; η_r = 5.02, 2.76, 3.57 at x = 0.01, 1, 100 against COT 4.81, 2.58,
-    3.29 (+4.3, +7.0, +8.6 %). With μ_c = 0.5 as well: g = 7.90; 7.50, 4.13, 7.07 against 7.80,
+    Measured (2026-12-07 evening, the defaults with the spin correction and the cutoff 0.44 h,
+    this test's packing): g = 4.751; η_r = 4.96, 2.72, 3.41 at x = 0.01, 1, 100 against COT
+    4.71, 2.55, 3.23 (+5.4, +6.9, +5.7 %). With the one-phase cutoff 0.58 h (2026-12-06
+    evening, strain 2–10): g = 4.856; η_r = 5.02, 2.76, 3.57 against COT 4.81, 2.58, 3.29
+    (+4.3, +7.0, +8.6 %). With μ_c = 0.5 as well: g = 7.90; 7.50, 4.13, 7.07 against 7.80,
     3.43, 5.05 (−3.9, +21, +40 %), so friction is not the default. Without the correction
     (the ``bingham_suspension`` study's packing, strain 2–10, g = 3.70 ± 0.12):
     η_r = 3.80, 2.00, 2.76 at x = 0.01, 1, 100 against COT 3.68, 2.19, 2.60, and within
