@@ -19,12 +19,8 @@ run's force depends on where the spheres meet the start lattice).
 Hydrodynamic radius (:func:`stokes_drag`): one sphere at prescribed speed U relative to the
 mean fluid velocity in the same box. SPH conserves momentum, so the fluid's mean velocity grows
 as ū_f = −Σ F δt / M_fluid; the sphere is driven at U + ū_f so that its speed relative to the
-fluid is U, the frame of Hasimoto's periodic-array result. a_h solves (SPEC §3.1)
-
-    F = 6πμ a_h U / (1 + c₁ a_h + (4π/3) a_h³/V − 27.4 (a_h/L)⁶),
-
-with c₁ the point-force periodic self-correction of the box (``periodic_pair``,
-c₁ L = −2.837297 for a cube: Hasimoto 1959) and (4π/3)a³/V ≈ 4.19 (a/L)³ for a cube.
+fluid is U, the frame of Hasimoto's periodic-array result. a_h solves
+F = 6πμ a_h U × :func:`~suspsim.validation.periodic_pair.hasimoto_factor` (a_h, box) (SPEC §3.1).
 
 Theory: Jeffrey & Onishi's two-sphere resistances with the box's periodic images
 (:mod:`~suspsim.validation.periodic_pair`: :func:`squeeze_theory`, :func:`sliding_theory`).
