@@ -38,7 +38,7 @@ def test_default_config_runs_nothing_and_the_studies_list_their_runs():
     full = _block("bingham_suspension")
     assert study_settings(full)["rates"] == [0.01, 0.0316, 0.1, 0.316, 1, 3.16, 10, 31.6, 100,
                                              316, 1000]
-    assert len(suspension_jobs(full)) == 12
+    assert len(suspension_jobs(full)) == 36
     smoke = study_settings(_block("bingham_suspension_smoke"))
     assert smoke["rates"] == [1] and smoke["volume_fraction"] == 0.2
     assert smoke["box"] == 10 and smoke["strain"] <= 1.5
