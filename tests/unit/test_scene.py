@@ -246,8 +246,9 @@ def test_shifting_auto_is_on_only_with_inclusions(tmp_path, newtonian, expected)
     ("numerics: {shifting: 100}\n", True, 0.185), ("numerics: {shifting: 300}\n", True, 0.185),
     ("numerics: {shifting: 10}\n", True, 0.2797),
     ("numerics: {shifting: 100, shifting_at_bodies: tangential}\n", True, 0.185),
-    ("numerics: {shifting_at_bodies: tangential}\n", True, 0.437),
-    ("numerics: {shifting: 10, shifting_at_bodies: tangential}\n", True, 0.3760),
+    ("numerics: {shifting_at_bodies: tangential}\n", True, 0.583),
+    ("numerics: {shifting: 10, shifting_at_bodies: tangential}\n", True, 0.3713),
+    ("numerics: {shifting: 30, shifting_at_bodies: tangential}\n", True, 0.246),
     ("numerics: {spin_correction: false, shifting: 30}\n", False, 0.778)])
 def test_spin_correction_and_cutoff_auto_follow_the_squeeze_calibration(tmp_path, extra, spin,
                                                                        cutoff):

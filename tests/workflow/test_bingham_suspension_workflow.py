@@ -13,19 +13,20 @@ from suspsim.stages.bingham_suspension_gather import cot_relative_viscosity, rea
 from test_snakemake import _dry_jobs, _jobs, _run, _study
 
 
-def test_study_lists_one_packing_a_newtonian_run_and_one_run_per_rate(tmp_path):
+def test_study_lists_a_packing_a_newtonian_run_and_one_run_per_rate_for_each_seed(tmp_path):
     study = _study(tmp_path, {})
     dry = _run(study, "-n", "--configfile", "config/studies/bingham_suspension.yaml")
     assert dry.returncode == 0, dry.stderr
-    assert _jobs(dry) == {"pack_bingham_suspension": 1, "simulate_bingham_suspension": 12,
+    assert _jobs(dry) == {"pack_bingham_suspension": 3, "simulate_bingham_suspension": 36,
                           "gather_bingham_suspension": 1, "plot_bingham_suspension": 1,
                           "all": 1}
     cases = sorted(job["case"] for job in _dry_jobs(dry, "simulate_bingham_suspension"))
-    assert cases == sorted(["newtonian", "x-0.01", "x-0.0316", "x-0.1", "x-0.316", "x-1",
-                            "x-3.16", "x-10", "x-31.6", "x-100", "x-316", "x-1000"])
+    assert cases == sorted(3 * ["newtonian", "x-0.01", "x-0.0316", "x-0.1", "x-0.316", "x-1",
+                                "x-3.16", "x-10", "x-31.6", "x-100", "x-316", "x-1000"])
     text = dry.stdout + dry.stderr
     assert "results/bingham_suspension/fig3.png" in text
-    assert "results/bingham_suspension/packings/seed-1.nc" in text
+    for seed in (1, 2, 3):
+        assert f"results/bingham_suspension/packings/seed-{seed}.nc" in text
 
 
 def test_default_config_lists_no_bingham_suspension_job(tmp_path):
