@@ -345,7 +345,7 @@ def test_bingham_matrix_follows_homogenisation(x):
     the Newtonian η_r of the same packing, at both ends, where the matrix is nearly Newtonian,
     at the yield-dominated x = 1 and at the dip x = 3.16; and at x = 1 well below g (seed 000:
     "only about a factor of two to three higher" than the matrix). This packing is the
-    ``bingham_suspension`` study's packing 1; the study checks all 11 rates on three packings.
+    ``bingham_suspension`` study's packing 1; the study measures all 11 rates on three packings.
 
     g is measured with the non-Newtonian matrix's numerics (the power-law test says why).
     Measured (2026-12-07 evening, the defaults with the spin correction and the cutoff 0.44 h,
